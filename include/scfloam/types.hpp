@@ -1,0 +1,30 @@
+// Plain data that flows between the stages: points, scans, poses.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <vector>
+
+namespace scfloam {
+
+// One LiDAR return in the sensor frame. `time_s` is relative to the scan's timestamp
+// (0 when the source has no per-point time); `ring` is the beam index, -1 when unknown.
+struct LidarPoint {
+  float x = 0, y = 0, z = 0;
+  float intensity = 0;
+  float time_s = 0;
+  std::int16_t ring = -1;
+};
+
+struct Scan {
+  double timestamp_s = 0;
+  std::vector<LidarPoint> points;
+  bool has_ring = false;  // every point's ring came from the source
+  bool has_time = false;  // every point's time_s came from the source
+};
+
+// Rigid transforms are named for their frames: T_world_lidar maps lidar coordinates to world.
+using Pose = Eigen::Isometry3d;
+using PoseList = std::vector<Eigen::Isometry3d>;  // C++17 aligned new makes this safe
+
+}  // namespace scfloam
