@@ -1,0 +1,47 @@
+// F-LOAM odometry: one call per scan returns the scan's pose and its feature clouds.
+// The pipeline (src/pipeline) only uses this header; the odometry's internals stay in
+// src/features, src/registration and src/odometry.
+#pragma once
+
+#include <Eigen/Core>
+#include <memory>
+#include <vector>
+
+#include "scfloam/config.hpp"
+#include "scfloam/types.hpp"
+
+namespace scfloam {
+
+// Feature points in one frame (lidar frame unless a name says otherwise).
+using FeatureCloud = std::vector<Eigen::Vector3f>;
+
+struct OdometryResult {
+  Eigen::Isometry3d T_world_lidar = Eigen::Isometry3d::Identity();
+  FeatureCloud edges;   // downsampled edge features, lidar frame (after deskew)
+  FeatureCloud planes;  // downsampled plane features, lidar frame (after deskew)
+  double features_ms = 0;      // preprocessing + feature extraction
+  double registration_ms = 0;  // prediction + scan-to-map + map update
+  bool degenerate = false;     // the solve was poorly constrained in some direction
+};
+
+class Odometry {
+ public:
+  explicit Odometry(const OdometryConfig& config);
+  ~Odometry();
+  Odometry(const Odometry&) = delete;
+  Odometry& operator=(const Odometry&) = delete;
+
+  OdometryResult process(const Scan& scan);
+
+  // After a loop closure the pipeline moves past keyframes: rebuild the local map from
+  // (corrected pose, features) pairs and continue from `T_world_lidar_now`.
+  void reset_map(const std::vector<std::pair<Eigen::Isometry3d, const FeatureCloud*>>& edges_by_pose,
+                 const std::vector<std::pair<Eigen::Isometry3d, const FeatureCloud*>>& planes_by_pose,
+                 const Eigen::Isometry3d& T_world_lidar_now);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace scfloam
