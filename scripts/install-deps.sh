@@ -5,7 +5,7 @@ set -euo pipefail
 packages=(
   build-essential cmake git pkg-config
   libeigen3-dev libceres-dev libnanoflann-dev libtbb-dev libyaml-cpp-dev libcli11-dev
-  libgtest-dev libgmock-dev libbenchmark-dev libpng-dev zlib1g-dev
+  libgtest-dev libgmock-dev libbenchmark-dev libpng-dev zlib1g-dev nlohmann-json3-dev
   libsqlite3-dev libzstd-dev liblz4-dev
   python3 python3-matplotlib python3-numpy
 )
