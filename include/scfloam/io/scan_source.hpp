@@ -1,0 +1,32 @@
+// Where scans come from. The pipeline reads every input through this interface; readers for
+// KITTI directories, point-cloud folders and bags implement it.
+#pragma once
+
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "scfloam/types.hpp"
+
+namespace scfloam {
+
+class ScanSource {
+ public:
+  virtual ~ScanSource() = default;
+  virtual std::size_t size() const = 0;
+  // Thread-safe for distinct indices: the pipeline prefetches on another thread.
+  virtual Scan load(std::size_t index) const = 0;
+  // One line for humans: "KITTI sequence /path (4541 scans, ground truth, Tr)".
+  virtual std::string describe() const = 0;
+  // Velodyne -> camera-0 extrinsic when the input has one (KITTI's `Tr`): trajectories are
+  // then also written in KITTI's camera-0 convention.
+  virtual std::optional<Eigen::Isometry3d> T_cam0_lidar() const { return std::nullopt; }
+  // Ground truth as lidar poses relative to the first frame (T_lidar0_lidarI); empty if none.
+  virtual PoseList ground_truth_lidar() const { return {}; }
+};
+
+// Detects the kind of input at `path` and opens it; Error naming the path when it cannot.
+std::unique_ptr<ScanSource> open_scan_source(const std::filesystem::path& path);
+
+}  // namespace scfloam

@@ -1,0 +1,45 @@
+// The single entry point that knows the whole order of the stages: scans in, trajectory out.
+#pragma once
+
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "scfloam/config.hpp"
+#include "scfloam/io/scan_source.hpp"
+#include "scfloam/types.hpp"
+
+namespace scfloam {
+
+// The paper's methods as modes of one program (its Table I).
+enum class SlamMode {
+  kOdometry,   // F-LOAM: odometry only
+  kSimpleSc,   // Simple-SC-F-LOAM: raw-scan Scan Context, fixed gate, ICP loop registration
+  kOptimized,  // Optimized-SC-F-LOAM: feature Scan Context, adaptive gate, feature registration
+};
+std::optional<SlamMode> parse_mode(const std::string& name);
+std::string mode_name(SlamMode mode);
+
+struct RunOptions {
+  SlamMode mode = SlamMode::kOdometry;
+  std::size_t max_frames = 0;  // 0: every scan of the source
+  bool progress = true;        // progress bar on stderr
+};
+
+struct RunResult {
+  SlamMode mode = SlamMode::kOdometry;
+  std::vector<double> stamps_s;
+  PoseList T_world_lidar;            // every frame; optimized where the mode optimizes
+  PoseList odometry_T_world_lidar;   // every frame, as the odometry estimated it
+  std::vector<std::size_t> keyframe_frames;
+  std::size_t degenerate_frames = 0;
+  // Per-stage samples in milliseconds ("features", "registration", ...).
+  std::map<std::string, std::vector<double>> timing_ms;
+  double wall_s = 0;
+};
+
+RunResult run_slam(const ScanSource& source, const SlamConfig& config, const RunOptions& options);
+
+}  // namespace scfloam
