@@ -1,0 +1,62 @@
+// The KITTI odometry devkit metric (evaluate_odometry.cpp), in double precision.
+// Inputs are KITTI camera-0 poses (T_cam0_cam0I), or both trajectories in any one common
+// frame convention: the relative motions compared are expressed in the pose's own frame, so
+// mixing lidar-frame and camera-frame poses changes r_err/t_err (see docs/evaluation.md).
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "scfloam/types.hpp"
+
+namespace scfloam {
+
+// The devkit's segment lengths and first-frame step (every 10th frame: once a second at 10 Hz).
+inline constexpr std::array<double, 8> kKittiSegmentLengthsM = {100, 200, 300, 400,
+                                                                500, 600, 700, 800};
+inline constexpr std::size_t kKittiStepFrames = 10;
+
+// One evaluated segment: errors of the relative motion first -> last, divided by its length.
+struct KittiSegmentError {
+  std::size_t first_frame = 0, last_frame = 0;
+  double length_m = 0;
+  double t_err_ratio = 0;     // ||t(E)|| / length (devkit's t_err: multiply by 100 for %)
+  double r_err_rad_per_m = 0; // angle(R(E)) / length
+};
+
+struct KittiLengthError {
+  double length_m = 0;
+  double t_err_pct = 0;            // NaN when segments == 0
+  double r_err_deg_per_100m = 0;   // NaN when segments == 0
+  std::size_t segments = 0;
+};
+
+struct KittiMetric {
+  // Means over every segment of every length, as the devkit's stats.txt (scaled to % and
+  // deg/100 m). NaN when the ground-truth path is shorter than 100 m (segments == 0).
+  double t_err_pct = 0;
+  double r_err_deg_per_100m = 0;
+  std::size_t segments = 0;
+  double path_length_m = 0;  // along the ground truth
+  std::array<KittiLengthError, kKittiSegmentLengthsM.size()> per_length{};
+  std::vector<KittiSegmentError> segment_errors;
+  bool has_segments() const { return segments > 0; }
+  // "" when there are segments; otherwise why t_err/r_err are undefined.
+  std::string note;
+};
+
+// Cumulative path length along the poses' translations; [0] = 0 (devkit trajectoryDistances).
+std::vector<double> trajectory_distances_m(const PoseList& poses);
+
+// The first frame i >= first_frame with dist[i] > dist[first_frame] + length_m, or -1 when the
+// path ends before (devkit lastFrameFromSegmentLength).
+long last_frame_from_segment_length(const std::vector<double>& dist_m, std::size_t first_frame,
+                                    double length_m);
+
+// Throws scfloam::Error when the two lists differ in length or are empty (the devkit needs a
+// pose for every frame).
+KittiMetric kitti_metric(const PoseList& gt, const PoseList& est);
+
+}  // namespace scfloam

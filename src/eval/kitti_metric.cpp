@@ -1,0 +1,94 @@
+#include "scfloam/eval/kitti_metric.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "scfloam/error.hpp"
+#include "scfloam/se3.hpp"
+
+namespace scfloam {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kRadToDeg = 180.0 / M_PI;
+
+}  // namespace
+
+std::vector<double> trajectory_distances_m(const PoseList& poses) {
+  std::vector<double> dist(poses.size(), 0.0);
+  for (std::size_t i = 1; i < poses.size(); ++i)
+    dist[i] = dist[i - 1] + (poses[i].translation() - poses[i - 1].translation()).norm();
+  return dist;
+}
+
+long last_frame_from_segment_length(const std::vector<double>& dist_m, std::size_t first_frame,
+                                    double length_m) {
+  if (first_frame >= dist_m.size()) return -1;
+  const double target_m = dist_m[first_frame] + length_m;
+  for (std::size_t i = first_frame; i < dist_m.size(); ++i)
+    if (dist_m[i] > target_m) return static_cast<long>(i);
+  return -1;
+}
+
+KittiMetric kitti_metric(const PoseList& gt, const PoseList& est) {
+  if (gt.empty()) throw Error("KITTI metric: the ground truth has no poses");
+  if (gt.size() != est.size())
+    throw Error("KITTI metric: ground truth has " + std::to_string(gt.size()) +
+                " poses but the estimate has " + std::to_string(est.size()) +
+                " (the metric needs a pose for every frame)");
+  KittiMetric m;
+  const std::vector<double> dist = trajectory_distances_m(gt);
+  m.path_length_m = dist.back();
+
+  std::array<double, kKittiSegmentLengthsM.size()> t_sum{}, r_sum{};
+  double t_total = 0, r_total = 0;
+  for (std::size_t first = 0; first < gt.size(); first += kKittiStepFrames) {
+    for (std::size_t li = 0; li < kKittiSegmentLengthsM.size(); ++li) {
+      const double len = kKittiSegmentLengthsM[li];
+      const long last = last_frame_from_segment_length(dist, first, len);
+      if (last < 0) continue;
+      const Pose delta_gt = gt[first].inverse() * gt[last];
+      const Pose delta_est = est[first].inverse() * est[last];
+      const Pose E = delta_est.inverse() * delta_gt;
+      KittiSegmentError s;
+      s.first_frame = first;
+      s.last_frame = static_cast<std::size_t>(last);
+      s.length_m = len;
+      s.t_err_ratio = E.translation().norm() / len;
+      s.r_err_rad_per_m = rotation_angle_rad(E.linear()) / len;
+      t_sum[li] += s.t_err_ratio;
+      r_sum[li] += s.r_err_rad_per_m;
+      t_total += s.t_err_ratio;
+      r_total += s.r_err_rad_per_m;
+      ++m.per_length[li].segments;
+      m.segment_errors.push_back(s);
+    }
+  }
+
+  m.segments = m.segment_errors.size();
+  for (std::size_t li = 0; li < kKittiSegmentLengthsM.size(); ++li) {
+    auto& pl = m.per_length[li];
+    pl.length_m = kKittiSegmentLengthsM[li];
+    const double n = static_cast<double>(pl.segments);
+    pl.t_err_pct = pl.segments ? 100.0 * t_sum[li] / n : kNaN;
+    pl.r_err_deg_per_100m = pl.segments ? 100.0 * kRadToDeg * r_sum[li] / n : kNaN;
+  }
+  if (m.segments > 0) {
+    const double n = static_cast<double>(m.segments);
+    m.t_err_pct = 100.0 * t_total / n;
+    m.r_err_deg_per_100m = 100.0 * kRadToDeg * r_total / n;
+  } else {
+    m.t_err_pct = kNaN;
+    m.r_err_deg_per_100m = kNaN;
+    char buf[160];
+    std::snprintf(buf, sizeof buf,
+                  "no KITTI segments: the ground-truth path is %.1f m, shorter than the "
+                  "shortest segment (100 m); t_err and r_err are undefined",
+                  m.path_length_m);
+    m.note = buf;
+  }
+  return m;
+}
+
+}  // namespace scfloam
