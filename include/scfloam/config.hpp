@@ -7,10 +7,72 @@
 
 namespace scfloam {
 
-// Filled in by the odometry work (issue 3): preprocessing, rings, features, registration,
-// local map. Sections for loop detection, loop registration and the pose graph follow.
+// Range crop and motion compensation of the raw scan.
+struct PreprocessConfig {
+  double min_range_m = 3.0;   // horizontal range sqrt(x^2+y^2) kept in [min, max] (KITTI launch)
+  double max_range_m = 90.0;
+  // Constant-velocity deskew using per-point time_s; only applied when the scan has times.
+  // Off for KITTI: its scans are already motion-compensated.
+  bool deskew = false;
+};
+
+// Which beam each point belongs to.
+struct RingConfig {
+  // Elevation table: "hdl64" (KITTI two-block layout), "hdl32", "vlp16", "os1-64", "os1-128".
+  std::string lidar = "hdl64";
+  bool use_ring_field = true;     // take LidarPoint::ring when the scan carries it
+  int min_points_per_ring = 131;  // F-LOAM skips sparser rings
+};
+
+// Curvature and edge/plane selection per ring.
+struct FeatureConfig {
+  int curvature_half_window = 5;     // neighbours each side on the ring
+  int sectors_per_ring = 6;
+  int max_edges_per_sector = 20;
+  double edge_min_curvature = 0.1;   // squared-norm curvature, F-LOAM's unit (m^2)
+  double suppression_gap_m = 0.2236; // neighbours of an edge are suppressed while closer than this
+  // LOAM's occlusion test: at a depth jump between neighbours at nearly the same bearing
+  // (gap / range < occlusion_gap_ratio), the far side's points are hidden or revealed as the
+  // sensor moves, so they may not become edges.
+  bool reject_occluded = true;
+  double occlusion_gap_ratio = 0.1;
+  double edge_leaf_m = 0.4;  // voxel-grid downsampling of the feature clouds
+  double plane_leaf_m = 0.8;
+};
+
+// Scan-to-map registration (also used by loop registration).
+struct RegistrationConfig {
+  int knn = 5;
+  double max_neighbor_dist_m = 1.0;  // the k-th neighbour must lie within this
+  double edge_line_ratio = 3.0;      // largest covariance eigenvalue > ratio * second
+  double plane_max_dist_m = 0.2;     // every neighbour within this of the fitted plane
+  double huber_delta_m = 0.1;
+  int inner_iterations = 4;          // Ceres iterations per correspondence round
+  int outer_iterations = 2;          // correspondence rounds per frame in steady state
+  int outer_iterations_initial = 12; // rounds on the first frame, decreasing by one per frame
+  // Stop the rounds early once one moves the pose less than both of these.
+  double converged_translation_m = 0.001;
+  double converged_rotation_deg = 0.01;
+  // Smallest eigenvalue of the translation block of J^T J (in units of "well-constrained
+  // residuals") below which a solve is reported degenerate.
+  double degeneracy_min_eigenvalue = 50.0;
+  int num_threads = 2;               // TBB correspondence search and Ceres evaluation
+};
+
+// The local feature map around the current pose.
+struct LocalMapConfig {
+  double edge_spacing_m = 0.4;   // a new map point closer than this to a stored one is dropped
+  double plane_spacing_m = 0.8;
+  int max_points_per_cell = 20;  // hash cells are 2 * max_neighbor_dist_m wide
+  double radius_m = 100.0;       // cells farther than this from the pose are removed
+};
+
 struct OdometryConfig {
-  // placeholder fields are not allowed: each section lists real parameters with defaults
+  PreprocessConfig preprocess;
+  RingConfig rings;
+  FeatureConfig features;
+  RegistrationConfig registration;
+  LocalMapConfig map;
 };
 
 struct SlamConfig {
@@ -19,5 +81,8 @@ struct SlamConfig {
 
 // Reads a YAML file; unknown keys and wrong types are errors naming the file and the key.
 SlamConfig load_config(const std::filesystem::path& path);
+// The whole config as YAML (every key, current values); load_config reads it back unchanged.
+std::string config_to_yaml(const SlamConfig& config);
+void save_config(const std::filesystem::path& path, const SlamConfig& config);
 
 }  // namespace scfloam

@@ -27,4 +27,7 @@ struct Scan {
 using Pose = Eigen::Isometry3d;
 using PoseList = std::vector<Eigen::Isometry3d>;  // C++17 aligned new makes this safe
 
+// Feature points (edges or planes) of one frame, lidar frame unless a name says otherwise.
+using FeatureCloud = std::vector<Eigen::Vector3f>;
+
 }  // namespace scfloam

@@ -12,9 +12,6 @@
 
 namespace scfloam {
 
-// Feature points in one frame (lidar frame unless a name says otherwise).
-using FeatureCloud = std::vector<Eigen::Vector3f>;
-
 struct OdometryResult {
   Eigen::Isometry3d T_world_lidar = Eigen::Isometry3d::Identity();
   FeatureCloud edges;   // downsampled edge features, lidar frame (after deskew)
@@ -22,6 +19,11 @@ struct OdometryResult {
   double features_ms = 0;      // preprocessing + feature extraction
   double registration_ms = 0;  // prediction + scan-to-map + map update
   bool degenerate = false;     // the solve was poorly constrained in some direction
+  // Diagnostics of the scan-to-map solve (zero on the first frame).
+  int edge_matches = 0;
+  int plane_matches = 0;
+  double mean_residual_m = 0;
+  double min_translation_eigenvalue = 0;  // of J^T J; see RegistrationConfig
 };
 
 class Odometry {

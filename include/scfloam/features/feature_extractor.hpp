@@ -1,0 +1,59 @@
+// F-LOAM feature extraction: range crop, rings, curvature per ring, edge selection per sector
+// with neighbour suppression; the remaining points are plane points. Output is not yet
+// voxel-downsampled (the odometry does that with registration/voxel_filter.hpp).
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "scfloam/config.hpp"
+#include "scfloam/features/rings.hpp"
+#include "scfloam/types.hpp"
+
+namespace scfloam {
+
+// Curvature of each point of one ring in F-LOAM's unit: squared norm of (sum of the
+// 2*half_window neighbours - 2*half_window * p). Points within half_window of either end get 0.
+void ring_curvature(const Eigen::Vector3f* points, int n, int half_window, float* curvature);
+
+struct FeatureStats {
+  int input_points = 0;
+  int kept_points = 0;  // after crop and ring assignment
+  int rings_used = 0;
+  int rings_resorted = 0;  // rings that were not in azimuth order and had to be sorted
+};
+
+class FeatureExtractor {
+ public:
+  FeatureExtractor(const PreprocessConfig& preprocess, const RingConfig& rings,
+                   const FeatureConfig& features);
+
+  // `use_ring_field`: take LidarPoint::ring (the scan has rings and the config allows it).
+  // Buffers persist between calls: steady-state use allocates nothing.
+  void extract(const std::vector<LidarPoint>& points, bool use_ring_field, FeatureCloud& edges,
+               FeatureCloud& planes);
+  const FeatureStats& stats() const { return stats_; }
+
+ private:
+  void assign_rings(const std::vector<LidarPoint>& points, bool use_ring_field);
+  void order_ring_by_azimuth(int ring);
+  void select_in_ring(int ring);
+
+  PreprocessConfig pre_;
+  FeatureConfig feat_;
+  LidarModel model_;
+  int min_points_per_ring_;
+  int beams_;
+
+  std::vector<std::int16_t> ring_of_;        // per input point, -1 = dropped
+  std::vector<int> ring_begin_;              // offsets into ordered_ (beams_ + 1)
+  std::vector<Eigen::Vector3f> ordered_;     // kept points grouped by ring
+  std::vector<float> curvature_, range_;
+  std::vector<char> picked_, unreliable_;
+  std::vector<std::vector<int>> candidates_;     // per ring scratch
+  std::vector<FeatureCloud> ring_edges_, ring_planes_;
+  std::vector<std::pair<float, int>> sort_scratch_;
+  FeatureStats stats_;
+};
+
+}  // namespace scfloam

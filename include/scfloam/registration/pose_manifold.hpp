@@ -1,0 +1,34 @@
+// The pose parameter block and its Ceres 2.1 manifold.
+//
+// Block layout (7 doubles): quaternion x, y, z, w (Eigen's coeffs order), translation x, y, z.
+// Tangent (6): delta = [omega; v], applied as R' = exp(omega) * R, t' = t + v. Rotating about
+// the sensor's position rather than the world origin keeps the rotation and translation
+// columns of the Jacobian decoupled even far from the origin.
+//
+// Jacobian convention (the usual trick of F-LOAM and others, stated here so nobody is
+// surprised): cost functions write d r / d delta into the first 6 of their 7 "ambient"
+// columns and zero into the 7th, and PlusJacobian is [I_6; 0]. Ceres multiplies the two, so
+// the solver sees exactly d r / d delta; tests/registration checks it against numerical
+// differentiation through Plus.
+#pragma once
+
+#include <ceres/manifold.h>
+
+#include <Eigen/Geometry>
+
+namespace scfloam {
+
+class PoseManifold : public ceres::Manifold {
+ public:
+  int AmbientSize() const override { return 7; }
+  int TangentSize() const override { return 6; }
+  bool Plus(const double* x, const double* delta, double* x_plus_delta) const override;
+  bool PlusJacobian(const double* x, double* jacobian) const override;
+  bool Minus(const double* y, const double* x, double* y_minus_x) const override;
+  bool MinusJacobian(const double* x, double* jacobian) const override;
+};
+
+void pose_to_block(const Eigen::Isometry3d& T, double* block);
+Eigen::Isometry3d block_to_pose(const double* block);  // re-normalises the quaternion
+
+}  // namespace scfloam

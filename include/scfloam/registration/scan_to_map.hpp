@@ -1,0 +1,77 @@
+// Feature-to-map registration: edges to lines, planes to planes, solved on Ceres with the
+// correspondences refreshed between solver rounds. Used by the odometry (frame to local map)
+// and by loop registration (keyframe to submap); depends on nothing but core and Ceres.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <vector>
+
+#include "scfloam/config.hpp"
+#include "scfloam/registration/feature_costs.hpp"
+#include "scfloam/registration/voxel_map.hpp"
+#include "scfloam/types.hpp"
+
+namespace scfloam {
+
+// Edge and plane points in world coordinates.
+class FeatureMap {
+ public:
+  FeatureMap(const RegistrationConfig& registration, const LocalMapConfig& map);
+
+  // Adds a frame's features placed at T_world_lidar.
+  void insert(const FeatureCloud& edges_lidar, const FeatureCloud& planes_lidar,
+              const Eigen::Isometry3d& T_world_lidar);
+  void remove_far(const Eigen::Vector3d& center, double radius_m);
+  void clear();
+
+  const VoxelMap& edges() const { return edges_; }
+  const VoxelMap& planes() const { return planes_; }
+
+ private:
+  VoxelMap edges_, planes_;
+};
+
+struct RegistrationResult {
+  Eigen::Isometry3d T_world_lidar = Eigen::Isometry3d::Identity();
+  int edge_matches = 0;   // accepted correspondences of the final round
+  int plane_matches = 0;
+  double mean_residual_m = 0;  // mean point-to-line/plane distance of those, before the loss
+  int rounds = 0;              // correspondence rounds actually run
+  // Gauss-Newton Hessian J^T J of the final round at the solution, tangent [omega; v].
+  Eigen::Matrix<double, 6, 6> hessian = Eigen::Matrix<double, 6, 6>::Zero();
+  Eigen::Vector3d rotation_eigenvalues = Eigen::Vector3d::Zero();     // ascending
+  Eigen::Vector3d translation_eigenvalues = Eigen::Vector3d::Zero();  // ascending
+  Eigen::Vector3d weakest_translation_dir = Eigen::Vector3d::Zero();  // world frame, unit
+  bool degenerate = false;  // smallest translation eigenvalue < degeneracy_min_eigenvalue
+};
+
+// Keeps its buffers between calls; one instance per thread.
+class ScanToMapRegistration {
+ public:
+  explicit ScanToMapRegistration(const RegistrationConfig& config);
+
+  RegistrationResult align(const FeatureCloud& edges_lidar, const FeatureCloud& planes_lidar,
+                           const FeatureMap& map, const Eigen::Isometry3d& T_world_lidar_init,
+                           int rounds);
+
+  // Correspondences of the last round (for tests and diagnostics).
+  const std::vector<EdgeMatch>& edge_matches() const { return edge_out_; }
+  const std::vector<PlaneMatch>& plane_matches() const { return plane_out_; }
+
+ private:
+  void find_matches(const FeatureCloud& edges, const FeatureCloud& planes, const FeatureMap& map,
+                    const Eigen::Isometry3d& T_world_lidar);
+
+  RegistrationConfig config_;
+  std::vector<EdgeMatch> edge_all_, edge_out_;
+  std::vector<PlaneMatch> plane_all_, plane_out_;
+  std::vector<char> edge_ok_, plane_ok_;
+};
+
+// One-off convenience: `rounds` correspondence rounds from T_world_lidar_init.
+RegistrationResult register_features(const FeatureCloud& edges_lidar,
+                                     const FeatureCloud& planes_lidar, const FeatureMap& map,
+                                     const Eigen::Isometry3d& T_world_lidar_init,
+                                     const RegistrationConfig& config, int rounds);
+
+}  // namespace scfloam

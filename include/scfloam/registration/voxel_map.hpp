@@ -1,0 +1,64 @@
+// Incremental local map of feature points: hash cells with a bounded number of points each.
+// Replaces F-LOAM's "crop the map and rebuild a k-d tree every frame": inserting a frame and
+// dropping far cells cost O(points touched), and a k-nearest query reads at most 8 cells.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "scfloam/registration/voxel_hash.hpp"
+#include "scfloam/types.hpp"
+
+namespace scfloam {
+
+class VoxelMap {
+ public:
+  static constexpr int kMaxK = 8;
+
+  struct Neighbors {
+    std::array<Eigen::Vector3f, kMaxK> points;
+    std::array<float, kMaxK> sq_dist;
+    int count = 0;  // sorted by distance, nearest first
+  };
+
+  // Queries are exact within `max_query_radius_m` (cells are twice that wide). A point is not
+  // stored when one already in its cell lies within `min_spacing_m`, or the cell is full.
+  VoxelMap(double max_query_radius_m, double min_spacing_m, int max_points_per_cell);
+
+  // Adds T_world_lidar * p for every p in `points_lidar`; returns how many were stored.
+  std::size_t insert(const FeatureCloud& points_lidar, const Eigen::Isometry3d& T_world_lidar);
+
+  // The k (<= kMaxK) nearest stored points within `radius_m` (<= max_query_radius_m) of q.
+  void knn(const Eigen::Vector3f& q, int k, float radius_m, Neighbors& out) const;
+
+  // Drops every cell whose centre lies farther than radius_m from `center`.
+  void remove_far(const Eigen::Vector3d& center, double radius_m);
+
+  void clear();
+  std::size_t num_points() const { return num_points_; }
+  std::size_t num_cells() const { return cells_.size(); }
+  double max_query_radius_m() const { return 0.5 * cell_size_; }
+  // Every stored point (for saving maps and debugging; order unspecified).
+  FeatureCloud points() const;
+
+ private:
+  struct Cell {
+    Eigen::Vector3i coords;
+    std::uint32_t count = 0;
+  };
+
+  const Eigen::Vector3f* cell_points(std::uint32_t cell) const {
+    return &pool_[static_cast<std::size_t>(cell) * max_per_cell_];
+  }
+
+  float cell_size_, inv_cell_size_, min_spacing_sq_;
+  std::uint32_t max_per_cell_;
+  FlatKeyIndex index_;
+  std::vector<Cell> cells_;
+  std::vector<Eigen::Vector3f> pool_;  // max_per_cell_ slots per cell
+  std::size_t num_points_ = 0;
+};
+
+}  // namespace scfloam

@@ -1,0 +1,205 @@
+#include "scfloam/features/feature_extractor.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "scfloam/error.hpp"
+
+namespace scfloam {
+
+namespace {
+
+// atan for |x| <= 1, |error| <= 1e-5 rad (Abramowitz & Stegun 4.4.47): 5x cheaper than atan2,
+// and 6e-4 deg is far below the 1/3 deg beam spacing.
+inline float fast_atan_unit(float x) {
+  const float x2 = x * x;
+  return x * (0.9998660f + x2 * (-0.3302995f + x2 * (0.1801410f + x2 * (-0.0851330f + x2 * 0.0208351f))));
+}
+
+inline float elevation_deg(float z, float horizontal_range) {
+  constexpr float kDeg = 180.0f / static_cast<float>(M_PI);
+  const float az = std::abs(z);
+  const float a = az <= horizontal_range
+                      ? fast_atan_unit(az / horizontal_range)
+                      : static_cast<float>(M_PI / 2) - fast_atan_unit(horizontal_range / az);
+  return (z < 0 ? -a : a) * kDeg;
+}
+
+}  // namespace
+
+void ring_curvature(const Eigen::Vector3f* p, int n, int hw, float* curvature) {
+  std::fill(curvature, curvature + n, 0.f);
+  if (n < 2 * hw + 1) return;
+  // Sliding window sum in double: float prefix sums lose centimetres at 90 m ranges.
+  Eigen::Vector3d window = Eigen::Vector3d::Zero();
+  for (int j = 0; j < 2 * hw + 1; ++j) window += p[j].cast<double>();
+  for (int i = hw; i < n - hw; ++i) {
+    if (i > hw) window += p[i + hw].cast<double>() - p[i - hw - 1].cast<double>();
+    const Eigen::Vector3d d = window - (2 * hw + 1) * p[i].cast<double>();
+    curvature[i] = static_cast<float>(d.squaredNorm());
+  }
+}
+
+FeatureExtractor::FeatureExtractor(const PreprocessConfig& preprocess, const RingConfig& rings,
+                                   const FeatureConfig& features)
+    : pre_(preprocess),
+      feat_(features),
+      model_(parse_lidar_model(rings.lidar)),
+      min_points_per_ring_(rings.min_points_per_ring),
+      beams_(num_beams(model_)) {
+  if (features.curvature_half_window < 1) throw Error("features: curvature_half_window must be >= 1");
+  if (features.sectors_per_ring < 1) throw Error("features: sectors_per_ring must be >= 1");
+  ring_begin_.resize(beams_ + 1);
+  candidates_.resize(beams_);
+  ring_edges_.resize(beams_);
+  ring_planes_.resize(beams_);
+}
+
+void FeatureExtractor::assign_rings(const std::vector<LidarPoint>& points, bool use_ring_field) {
+  const std::size_t n = points.size();
+  ring_of_.resize(n);
+  const float min_r2 = static_cast<float>(pre_.min_range_m * pre_.min_range_m);
+  const float max_r2 = static_cast<float>(pre_.max_range_m * pre_.max_range_m);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const auto& range) {
+    for (std::size_t i = range.begin(); i != range.end(); ++i) {
+      const LidarPoint& p = points[i];
+      const float r2 = p.x * p.x + p.y * p.y;
+      std::int16_t ring = -1;
+      if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z) && r2 > 0 && r2 >= min_r2 &&
+          r2 <= max_r2) {
+        if (use_ring_field) {
+          ring = (p.ring >= 0 && p.ring < beams_) ? p.ring : -1;
+        } else {
+          ring = static_cast<std::int16_t>(
+              ring_from_elevation_deg(model_, elevation_deg(p.z, std::sqrt(r2))));
+        }
+      }
+      ring_of_[i] = ring;
+    }
+  });
+  // Counting sort by ring, keeping the input (acquisition) order within each ring.
+  std::fill(ring_begin_.begin(), ring_begin_.end(), 0);
+  for (std::size_t i = 0; i < n; ++i)
+    if (ring_of_[i] >= 0) ++ring_begin_[ring_of_[i] + 1];
+  for (int r = 0; r < beams_; ++r) ring_begin_[r + 1] += ring_begin_[r];
+  ordered_.resize(ring_begin_[beams_]);
+  std::vector<int>& cursor = candidates_[0];  // reuse a scratch vector as write cursors
+  cursor.assign(ring_begin_.begin(), ring_begin_.end() - 1);
+  for (std::size_t i = 0; i < n; ++i)
+    if (ring_of_[i] >= 0) ordered_[cursor[ring_of_[i]]++] = Eigen::Vector3f(points[i].x, points[i].y, points[i].z);
+}
+
+void FeatureExtractor::order_ring_by_azimuth(int ring) {
+  Eigen::Vector3f* p = ordered_.data() + ring_begin_[ring];
+  const int n = ring_begin_[ring + 1] - ring_begin_[ring];
+  // Acquisition order is azimuth order for spinning sensors; check the turning direction of
+  // consecutive points and only sort rings that are out of order (e.g. merged packets).
+  int forward = 0, backward = 0;
+  for (int i = 0; i + 1 < n; ++i) {
+    const float cross = p[i].x() * p[i + 1].y() - p[i].y() * p[i + 1].x();
+    (cross > 0 ? forward : backward) += 1;
+  }
+  if (std::min(forward, backward) <= n / 50) return;
+  ++stats_.rings_resorted;
+  sort_scratch_.resize(n);
+  for (int i = 0; i < n; ++i) sort_scratch_[i] = {std::atan2(p[i].y(), p[i].x()), i};
+  std::sort(sort_scratch_.begin(), sort_scratch_.end());
+  std::vector<Eigen::Vector3f> copy(p, p + n);
+  for (int i = 0; i < n; ++i) p[i] = copy[sort_scratch_[i].second];
+}
+
+void FeatureExtractor::select_in_ring(int ring) {
+  FeatureCloud& edges = ring_edges_[ring];
+  FeatureCloud& planes = ring_planes_[ring];
+  edges.clear();
+  planes.clear();
+  const int begin = ring_begin_[ring];
+  const int n = ring_begin_[ring + 1] - begin;
+  const int hw = feat_.curvature_half_window;
+  if (n < min_points_per_ring_ || n < 2 * hw + 1 + feat_.sectors_per_ring) return;
+  const Eigen::Vector3f* p = ordered_.data() + begin;
+  float* curv = curvature_.data() + begin;
+  float* range = range_.data() + begin;
+  char* picked = picked_.data() + begin;
+  char* unreliable = unreliable_.data() + begin;
+  ring_curvature(p, n, hw, curv);
+  for (int i = 0; i < n; ++i) {
+    range[i] = p[i].norm();
+    picked[i] = 0;
+    unreliable[i] = 0;
+  }
+  if (feat_.reject_occluded) {
+    // LOAM's occlusion test: at a depth jump between neighbours seen at the same bearing, the
+    // far side's points are hidden or revealed as the sensor moves: never edges.
+    const float ratio = static_cast<float>(feat_.occlusion_gap_ratio);
+    for (int i = hw; i < n - hw - 1; ++i) {
+      if ((p[i + 1] - p[i]).squaredNorm() <= 0.1f) continue;
+      const float d1 = range[i], d2 = range[i + 1];
+      if (d1 > d2) {
+        if ((p[i + 1] - p[i] * (d2 / d1)).norm() / d2 < ratio)
+          for (int k = std::max(0, i - hw); k <= i; ++k) unreliable[k] = 1;
+      } else {
+        if ((p[i + 1] * (d1 / d2) - p[i]).norm() / d1 < ratio)
+          for (int k = i + 1; k <= std::min(n - 1, i + hw + 1); ++k) unreliable[k] = 1;
+      }
+    }
+  }
+  const float threshold = static_cast<float>(feat_.edge_min_curvature);
+  const float gap2 = static_cast<float>(feat_.suppression_gap_m * feat_.suppression_gap_m);
+  const int sectors = feat_.sectors_per_ring;
+  const int usable = n - 2 * hw;
+  std::vector<int>& cand = candidates_[ring];
+  for (int s = 0; s < sectors; ++s) {
+    const int sb = hw + usable * s / sectors, se = hw + usable * (s + 1) / sectors;
+    cand.clear();
+    for (int i = sb; i < se; ++i)
+      if (curv[i] > threshold && !unreliable[i]) cand.push_back(i);
+    std::sort(cand.begin(), cand.end(), [&](int a, int b) { return curv[a] > curv[b]; });
+    int chosen = 0;
+    for (int i : cand) {
+      if (chosen >= feat_.max_edges_per_sector) break;
+      if (picked[i]) continue;
+      edges.push_back(p[i]);
+      ++chosen;
+      picked[i] = 1;
+      for (int k = 1; k <= hw && i + k < n; ++k) {
+        if ((p[i + k] - p[i + k - 1]).squaredNorm() > gap2) break;
+        picked[i + k] = 1;
+      }
+      for (int k = 1; k <= hw && i - k >= 0; ++k) {
+        if ((p[i - k] - p[i - k + 1]).squaredNorm() > gap2) break;
+        picked[i - k] = 1;
+      }
+    }
+    for (int i = sb; i < se; ++i)
+      if (!picked[i]) planes.push_back(p[i]);
+  }
+}
+
+void FeatureExtractor::extract(const std::vector<LidarPoint>& points, bool use_ring_field,
+                               FeatureCloud& edges, FeatureCloud& planes) {
+  stats_ = FeatureStats{};
+  stats_.input_points = static_cast<int>(points.size());
+  assign_rings(points, use_ring_field);
+  stats_.kept_points = static_cast<int>(ordered_.size());
+  curvature_.resize(ordered_.size());
+  range_.resize(ordered_.size());
+  picked_.resize(ordered_.size());
+  unreliable_.resize(ordered_.size());
+  for (int r = 0; r < beams_; ++r) order_ring_by_azimuth(r);
+  tbb::parallel_for(tbb::blocked_range<int>(0, beams_, 1), [&](const auto& range) {
+    for (int r = range.begin(); r != range.end(); ++r) select_in_ring(r);
+  });
+  edges.clear();
+  planes.clear();
+  for (int r = 0; r < beams_; ++r) {
+    if (!ring_edges_[r].empty() || !ring_planes_[r].empty()) ++stats_.rings_used;
+    edges.insert(edges.end(), ring_edges_[r].begin(), ring_edges_[r].end());
+    planes.insert(planes.end(), ring_planes_[r].begin(), ring_planes_[r].end());
+  }
+}
+
+}  // namespace scfloam

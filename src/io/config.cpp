@@ -1,0 +1,169 @@
+// YAML <-> SlamConfig through one table of (section, key, field) bindings, so reading,
+// writing and the unknown-key check can never disagree about which keys exist.
+#include <yaml-cpp/yaml.h>
+
+#include <functional>
+#include <sstream>
+#include <variant>
+#include <vector>
+
+#include "scfloam/atomic_file.hpp"
+#include "scfloam/config.hpp"
+#include "scfloam/error.hpp"
+
+namespace scfloam {
+namespace {
+
+using FieldPtr = std::variant<double*, int*, bool*, std::string*>;
+
+struct Binding {
+  std::string section;  // dotted path of the YAML map holding the key, e.g. "odometry.features"
+  std::string key;
+  FieldPtr field;
+};
+
+std::vector<Binding> bindings(SlamConfig& c) {
+  auto& o = c.odometry;
+  const std::string pre = "odometry.preprocess", ring = "odometry.rings",
+                    feat = "odometry.features", reg = "odometry.registration",
+                    map = "odometry.map";
+  return {
+      {pre, "min_range_m", &o.preprocess.min_range_m},
+      {pre, "max_range_m", &o.preprocess.max_range_m},
+      {pre, "deskew", &o.preprocess.deskew},
+      {ring, "lidar", &o.rings.lidar},
+      {ring, "use_ring_field", &o.rings.use_ring_field},
+      {ring, "min_points_per_ring", &o.rings.min_points_per_ring},
+      {feat, "curvature_half_window", &o.features.curvature_half_window},
+      {feat, "sectors_per_ring", &o.features.sectors_per_ring},
+      {feat, "max_edges_per_sector", &o.features.max_edges_per_sector},
+      {feat, "edge_min_curvature", &o.features.edge_min_curvature},
+      {feat, "suppression_gap_m", &o.features.suppression_gap_m},
+      {feat, "reject_occluded", &o.features.reject_occluded},
+      {feat, "occlusion_gap_ratio", &o.features.occlusion_gap_ratio},
+      {feat, "edge_leaf_m", &o.features.edge_leaf_m},
+      {feat, "plane_leaf_m", &o.features.plane_leaf_m},
+      {reg, "knn", &o.registration.knn},
+      {reg, "max_neighbor_dist_m", &o.registration.max_neighbor_dist_m},
+      {reg, "edge_line_ratio", &o.registration.edge_line_ratio},
+      {reg, "plane_max_dist_m", &o.registration.plane_max_dist_m},
+      {reg, "huber_delta_m", &o.registration.huber_delta_m},
+      {reg, "inner_iterations", &o.registration.inner_iterations},
+      {reg, "outer_iterations", &o.registration.outer_iterations},
+      {reg, "outer_iterations_initial", &o.registration.outer_iterations_initial},
+      {reg, "converged_translation_m", &o.registration.converged_translation_m},
+      {reg, "converged_rotation_deg", &o.registration.converged_rotation_deg},
+      {reg, "degeneracy_min_eigenvalue", &o.registration.degeneracy_min_eigenvalue},
+      {reg, "num_threads", &o.registration.num_threads},
+      {map, "edge_spacing_m", &o.map.edge_spacing_m},
+      {map, "plane_spacing_m", &o.map.plane_spacing_m},
+      {map, "max_points_per_cell", &o.map.max_points_per_cell},
+      {map, "radius_m", &o.map.radius_m},
+  };
+}
+
+std::vector<std::string> split_dots(const std::string& s) {
+  std::vector<std::string> parts;
+  std::stringstream ss(s);
+  for (std::string p; std::getline(ss, p, '.');) parts.push_back(p);
+  return parts;
+}
+
+// Every map in the file must be a known section and every scalar a known key.
+void check_known(const YAML::Node& node, const std::string& prefix,
+                 const std::vector<Binding>& table, const std::filesystem::path& path) {
+  for (const auto& kv : node) {
+    const std::string name = kv.first.as<std::string>();
+    const std::string full = prefix.empty() ? name : prefix + "." + name;
+    bool is_section = false, is_key = false;
+    for (const auto& b : table) {
+      if (b.section == full || b.section.rfind(full + ".", 0) == 0) is_section = true;
+      if (b.section == prefix && b.key == name) is_key = true;
+    }
+    if (is_key) continue;
+    if (!is_section) throw file_error(path, "unknown key `" + full + "`");
+    if (!kv.second.IsMap()) throw file_error(path, "`" + full + "` must be a map of settings");
+    check_known(kv.second, full, table, path);
+  }
+}
+
+template <typename T>
+void read_scalar(const YAML::Node& n, T* out, const std::string& full,
+                 const std::filesystem::path& path, const char* type_name) {
+  if (!n.IsScalar()) throw file_error(path, "`" + full + "` must be " + type_name);
+  try {
+    *out = n.as<T>();
+  } catch (const YAML::Exception&) {
+    throw file_error(path, "`" + full + "` must be " + type_name + ", got `" + n.Scalar() + "`");
+  }
+}
+
+}  // namespace
+
+SlamConfig load_config(const std::filesystem::path& path) {
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path.string());
+  } catch (const YAML::BadFile&) {
+    throw file_error(path, "cannot open the config file");
+  } catch (const YAML::Exception& e) {
+    throw file_error(path, std::string("not valid YAML: ") + e.what());
+  }
+  SlamConfig config;
+  if (root.IsNull()) return config;  // empty file: all defaults
+  if (!root.IsMap()) throw file_error(path, "the top level must be a map of sections");
+  auto table = bindings(config);
+  check_known(root, "", table, path);
+  for (auto& b : table) {
+    // reset(), not operator=: assigning a yaml-cpp node overwrites the node it refers to.
+    YAML::Node n;
+    n.reset(root);
+    bool present = true;
+    for (const auto& part : split_dots(b.section)) {
+      const YAML::Node& cn = n;
+      if (!cn[part]) { present = false; break; }
+      n.reset(cn[part]);
+    }
+    const YAML::Node& cn = n;
+    if (!present || !cn[b.key]) continue;
+    const YAML::Node v = cn[b.key];
+    const std::string full = b.section + "." + b.key;
+    std::visit(
+        [&](auto* field) {
+          using T = std::remove_pointer_t<decltype(field)>;
+          if constexpr (std::is_same_v<T, double>) read_scalar(v, field, full, path, "a number");
+          if constexpr (std::is_same_v<T, int>) read_scalar(v, field, full, path, "an integer");
+          if constexpr (std::is_same_v<T, bool>) read_scalar(v, field, full, path, "true or false");
+          if constexpr (std::is_same_v<T, std::string>) read_scalar(v, field, full, path, "a string");
+        },
+        b.field);
+  }
+  return config;
+}
+
+std::string config_to_yaml(const SlamConfig& config) {
+  SlamConfig copy = config;
+  YAML::Node root;
+  for (auto& b : bindings(copy)) {
+    const auto parts = split_dots(b.section);
+    std::visit(
+        [&](auto* field) {
+          // Walk/create nested maps, then set the key.
+          std::vector<YAML::Node> chain{root};
+          for (const auto& part : parts) chain.push_back(chain.back()[part]);
+          chain.back()[b.key] = *field;
+        },
+        b.field);
+  }
+  YAML::Emitter out;
+  out.SetDoublePrecision(17);
+  out << root;
+  return std::string(out.c_str()) + "\n";
+}
+
+void save_config(const std::filesystem::path& path, const SlamConfig& config) {
+  const std::string text = config_to_yaml(config);
+  write_file_atomic(path, [&](std::ostream& os) { os << text; });
+}
+
+}  // namespace scfloam

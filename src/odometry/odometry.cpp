@@ -1,0 +1,114 @@
+#include "scfloam/odometry/odometry.hpp"
+
+#include "scfloam/error.hpp"
+#include "scfloam/features/deskew.hpp"
+#include "scfloam/features/feature_extractor.hpp"
+#include "scfloam/registration/scan_to_map.hpp"
+#include "scfloam/registration/voxel_filter.hpp"
+#include "scfloam/se3.hpp"
+#include "scfloam/stats.hpp"
+
+namespace scfloam {
+
+struct Odometry::Impl {
+  explicit Impl(const OdometryConfig& c)
+      : config(c),
+        extractor(c.preprocess, c.rings, c.features),
+        map(c.registration, c.map),
+        registration(c.registration),
+        rounds(c.registration.outer_iterations_initial) {}
+
+  OdometryConfig config;
+  FeatureExtractor extractor;
+  VoxelFilter filter;
+  FeatureMap map;
+  ScanToMapRegistration registration;
+
+  std::vector<LidarPoint> deskewed;
+  FeatureCloud raw_edges, raw_planes;
+  std::size_t frames = 0;
+  int rounds;
+  Eigen::Isometry3d T_last = Eigen::Isometry3d::Identity();  // T_world_lidar of frame k-1
+  Eigen::Isometry3d T_delta = Eigen::Isometry3d::Identity(); // T_{k-2}^-1 T_{k-1}
+  double last_stamp_s = 0;
+  double delta_dt_s = 0;
+  Eigen::Vector3d last_cleanup_position = Eigen::Vector3d::Zero();
+};
+
+Odometry::Odometry(const OdometryConfig& config) : impl_(std::make_unique<Impl>(config)) {
+  const auto& p = config.preprocess;
+  if (!(p.min_range_m >= 0) || !(p.max_range_m > p.min_range_m))
+    throw Error("odometry config: need 0 <= min_range_m < max_range_m");
+  if (config.registration.outer_iterations < 1 || config.registration.inner_iterations < 1)
+    throw Error("odometry config: outer_iterations and inner_iterations must be >= 1");
+}
+
+Odometry::~Odometry() = default;
+
+OdometryResult Odometry::process(const Scan& scan) {
+  Impl& s = *impl_;
+  const OdometryConfig& c = s.config;
+  OdometryResult result;
+  Stopwatch watch;
+
+  const std::vector<LidarPoint>* points = &scan.points;
+  if (c.preprocess.deskew && scan.has_time && s.frames >= 2 && s.delta_dt_s > 0) {
+    // Constant velocity from the last two poses, in the sensor's body frame.
+    s.deskewed = scan.points;
+    deskew_constant_velocity(s.deskewed, so3_log(s.T_delta.linear()) / s.delta_dt_s,
+                             s.T_delta.translation() / s.delta_dt_s);
+    points = &s.deskewed;
+  }
+  s.extractor.extract(*points, scan.has_ring && c.rings.use_ring_field, s.raw_edges, s.raw_planes);
+  s.filter.filter(s.raw_edges, c.features.edge_leaf_m, result.edges);
+  s.filter.filter(s.raw_planes, c.features.plane_leaf_m, result.planes);
+  result.features_ms = watch.elapsed_ms();
+  watch.restart();
+
+  if (s.frames == 0) {
+    result.T_world_lidar = Eigen::Isometry3d::Identity();
+  } else {
+    // Constant-velocity prediction T_k = T_{k-1} (T_{k-2}^-1 T_{k-1}), kept on SO(3).
+    const Eigen::Isometry3d T_pred = orthonormalized(s.T_last * s.T_delta);
+    const RegistrationResult reg =
+        s.registration.align(result.edges, result.planes, s.map, T_pred, s.rounds);
+    result.T_world_lidar = orthonormalized(reg.T_world_lidar);
+    result.degenerate = reg.degenerate;
+    result.edge_matches = reg.edge_matches;
+    result.plane_matches = reg.plane_matches;
+    result.mean_residual_m = reg.mean_residual_m;
+    result.min_translation_eigenvalue = reg.translation_eigenvalues[0];
+    s.rounds = std::max(c.registration.outer_iterations, s.rounds - 1);
+    s.T_delta = orthonormalized(s.T_last.inverse() * result.T_world_lidar);
+    s.delta_dt_s = scan.timestamp_s - s.last_stamp_s;
+  }
+  s.map.insert(result.edges, result.planes, result.T_world_lidar);
+  // Dropping far cells walks the whole map: do it every 10 m of travel, not every frame.
+  const Eigen::Vector3d position = result.T_world_lidar.translation();
+  if ((position - s.last_cleanup_position).norm() > 10.0) {
+    s.map.remove_far(position, c.map.radius_m);
+    s.last_cleanup_position = position;
+  }
+  s.T_last = result.T_world_lidar;
+  s.last_stamp_s = scan.timestamp_s;
+  ++s.frames;
+  result.registration_ms = watch.elapsed_ms();
+  return result;
+}
+
+void Odometry::reset_map(
+    const std::vector<std::pair<Eigen::Isometry3d, const FeatureCloud*>>& edges_by_pose,
+    const std::vector<std::pair<Eigen::Isometry3d, const FeatureCloud*>>& planes_by_pose,
+    const Eigen::Isometry3d& T_world_lidar_now) {
+  Impl& s = *impl_;
+  s.map.clear();
+  static const FeatureCloud kEmpty;
+  for (const auto& [T, cloud] : edges_by_pose) s.map.insert(cloud ? *cloud : kEmpty, kEmpty, T);
+  for (const auto& [T, cloud] : planes_by_pose) s.map.insert(kEmpty, cloud ? *cloud : kEmpty, T);
+  // Keep the current velocity: T_delta is relative, so it survives the correction unchanged.
+  s.T_last = orthonormalized(T_world_lidar_now);
+  s.map.remove_far(s.T_last.translation(), s.config.map.radius_m);
+  s.last_cleanup_position = s.T_last.translation();
+}
+
+}  // namespace scfloam

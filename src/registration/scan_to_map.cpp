@@ -1,0 +1,201 @@
+#include "scfloam/registration/scan_to_map.hpp"
+
+#include <ceres/ceres.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <Eigen/Eigenvalues>
+
+#include "scfloam/error.hpp"
+#include "scfloam/registration/pose_manifold.hpp"
+#include "scfloam/se3.hpp"
+
+namespace scfloam {
+
+FeatureMap::FeatureMap(const RegistrationConfig& registration, const LocalMapConfig& map)
+    : edges_(registration.max_neighbor_dist_m, map.edge_spacing_m, map.max_points_per_cell),
+      planes_(registration.max_neighbor_dist_m, map.plane_spacing_m, map.max_points_per_cell) {}
+
+void FeatureMap::insert(const FeatureCloud& edges_lidar, const FeatureCloud& planes_lidar,
+                        const Eigen::Isometry3d& T_world_lidar) {
+  edges_.insert(edges_lidar, T_world_lidar);
+  planes_.insert(planes_lidar, T_world_lidar);
+}
+
+void FeatureMap::remove_far(const Eigen::Vector3d& center, double radius_m) {
+  edges_.remove_far(center, radius_m);
+  planes_.remove_far(center, radius_m);
+}
+
+void FeatureMap::clear() {
+  edges_.clear();
+  planes_.clear();
+}
+
+ScanToMapRegistration::ScanToMapRegistration(const RegistrationConfig& config) : config_(config) {
+  if (config.knn < 3 || config.knn > VoxelMap::kMaxK)
+    throw Error("registration: knn must be in [3, " + std::to_string(VoxelMap::kMaxK) + "]");
+}
+
+namespace {
+
+// Mean and covariance of the k neighbours, eigen-decomposed (ascending eigenvalues).
+struct LocalShape {
+  Eigen::Vector3d mean;
+  Eigen::Vector3d eigenvalues;
+  Eigen::Matrix3d eigenvectors;
+};
+
+LocalShape local_shape(const VoxelMap::Neighbors& nb) {
+  LocalShape s;
+  s.mean.setZero();
+  for (int i = 0; i < nb.count; ++i) s.mean += nb.points[i].cast<double>();
+  s.mean /= nb.count;
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (int i = 0; i < nb.count; ++i) {
+    const Eigen::Vector3d d = nb.points[i].cast<double>() - s.mean;
+    cov += d * d.transpose();
+  }
+  cov /= nb.count;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
+  es.computeDirect(cov);
+  s.eigenvalues = es.eigenvalues();
+  s.eigenvectors = es.eigenvectors();
+  return s;
+}
+
+}  // namespace
+
+void ScanToMapRegistration::find_matches(const FeatureCloud& edges, const FeatureCloud& planes,
+                                         const FeatureMap& map,
+                                         const Eigen::Isometry3d& T_world_lidar) {
+  const Eigen::Isometry3f T = T_world_lidar.cast<float>();
+  const int k = config_.knn;
+  const float radius = static_cast<float>(config_.max_neighbor_dist_m);
+  edge_all_.resize(edges.size());
+  plane_all_.resize(planes.size());
+  edge_ok_.assign(edges.size(), 0);
+  plane_ok_.assign(planes.size(), 0);
+
+  const std::size_t n_edges = edges.size(), total = edges.size() + planes.size();
+  auto work = [&](const tbb::blocked_range<std::size_t>& range) {
+    VoxelMap::Neighbors nb;
+    for (std::size_t i = range.begin(); i != range.end(); ++i) {
+      if (i < n_edges) {
+        map.edges().knn(T * edges[i], k, radius, nb);
+        if (nb.count < k) continue;
+        const LocalShape s = local_shape(nb);
+        if (!(s.eigenvalues[2] > config_.edge_line_ratio * s.eigenvalues[1])) continue;
+        edge_all_[i] = {edges[i].cast<double>(), s.mean, s.eigenvectors.col(2)};
+        edge_ok_[i] = 1;
+      } else {
+        const std::size_t j = i - n_edges;
+        map.planes().knn(T * planes[j], k, radius, nb);
+        if (nb.count < k) continue;
+        const LocalShape s = local_shape(nb);
+        const Eigen::Vector3d n = s.eigenvectors.col(0);
+        const double offset = -n.dot(s.mean);
+        bool flat = true;
+        for (int m = 0; m < nb.count && flat; ++m)
+          flat = std::abs(n.dot(nb.points[m].cast<double>()) + offset) <= config_.plane_max_dist_m;
+        if (!flat) continue;
+        plane_all_[j] = {planes[j].cast<double>(), n, offset};
+        plane_ok_[j] = 1;
+      }
+    }
+  };
+  if (config_.num_threads > 1) {
+    tbb::task_arena arena(config_.num_threads);
+    arena.execute([&] { tbb::parallel_for(tbb::blocked_range<std::size_t>(0, total, 256), work); });
+  } else {
+    work(tbb::blocked_range<std::size_t>(0, total));
+  }
+  edge_out_.clear();
+  plane_out_.clear();
+  for (std::size_t i = 0; i < edges.size(); ++i)
+    if (edge_ok_[i]) edge_out_.push_back(edge_all_[i]);
+  for (std::size_t i = 0; i < planes.size(); ++i)
+    if (plane_ok_[i]) plane_out_.push_back(plane_all_[i]);
+}
+
+RegistrationResult ScanToMapRegistration::align(const FeatureCloud& edges_lidar,
+                                                const FeatureCloud& planes_lidar,
+                                                const FeatureMap& map,
+                                                const Eigen::Isometry3d& T_world_lidar_init,
+                                                int rounds) {
+  RegistrationResult result;
+  double pose[7];
+  pose_to_block(T_world_lidar_init, pose);
+  PoseManifold manifold;
+  constexpr std::size_t kMinMatches = 10;  // fewer cannot pin down 6 dof with any margin
+
+  for (int round = 0; round < rounds; ++round) {
+    find_matches(edges_lidar, planes_lidar, map, block_to_pose(pose));
+    if (edge_out_.size() + plane_out_.size() < kMinMatches) break;
+    FeatureCost cost(edge_out_, plane_out_, config_.huber_delta_m);
+    ceres::Problem::Options problem_options;
+    problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    ceres::Problem problem(problem_options);
+    problem.AddParameterBlock(pose, 7, &manifold);
+    problem.AddResidualBlock(&cost, nullptr, pose);
+    ceres::Solver::Options options;
+    options.linear_solver_type = ceres::DENSE_QR;  // 6 unknowns: dense is the right choice
+    options.max_num_iterations = config_.inner_iterations;
+    options.minimizer_progress_to_stdout = false;
+    options.logging_type = ceres::SILENT;
+    options.num_threads = 1;
+    ceres::Solver::Summary summary;
+    const Eigen::Isometry3d T_before = block_to_pose(pose);
+    ceres::Solve(options, &problem, &summary);
+    ++result.rounds;
+    const Eigen::Isometry3d step = T_before.inverse() * block_to_pose(pose);
+    if (step.translation().norm() < config_.converged_translation_m &&
+        rotation_angle_rad(step.linear()) * 180.0 / M_PI < config_.converged_rotation_deg)
+      break;
+  }
+
+  result.T_world_lidar = block_to_pose(pose);
+  result.edge_matches = static_cast<int>(edge_out_.size());
+  result.plane_matches = static_cast<int>(plane_out_.size());
+
+  // Hessian and residuals of the final matches at the solution.
+  const Eigen::Matrix3d R = result.T_world_lidar.linear();
+  const Eigen::Vector3d t = result.T_world_lidar.translation();
+  double sum_dist = 0;
+  for (const auto& m : edge_out_) {
+    Jacobian36 J;
+    Eigen::Vector3d r = edge_residual(m, R, t, &J);
+    sum_dist += r.norm();
+    robustify_huber<3>(config_.huber_delta_m, r, &J);
+    result.hessian += J.transpose() * J;
+  }
+  for (const auto& m : plane_out_) {
+    Jacobian16 J;
+    Eigen::Matrix<double, 1, 1> r(plane_residual(m, R, t, &J));
+    sum_dist += std::abs(r[0]);
+    robustify_huber<1>(config_.huber_delta_m, r, &J);
+    result.hessian += J.transpose() * J;
+  }
+  const std::size_t n = edge_out_.size() + plane_out_.size();
+  result.mean_residual_m = n ? sum_dist / n : 0;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> rot(result.hessian.topLeftCorner<3, 3>());
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> tra(result.hessian.bottomRightCorner<3, 3>());
+  result.rotation_eigenvalues = rot.eigenvalues();
+  result.translation_eigenvalues = tra.eigenvalues();
+  result.weakest_translation_dir = tra.eigenvectors().col(0);
+  result.degenerate = n < kMinMatches ||
+                      result.translation_eigenvalues[0] < config_.degeneracy_min_eigenvalue;
+  return result;
+}
+
+RegistrationResult register_features(const FeatureCloud& edges_lidar,
+                                     const FeatureCloud& planes_lidar, const FeatureMap& map,
+                                     const Eigen::Isometry3d& T_world_lidar_init,
+                                     const RegistrationConfig& config, int rounds) {
+  ScanToMapRegistration reg(config);
+  return reg.align(edges_lidar, planes_lidar, map, T_world_lidar_init, rounds);
+}
+
+}  // namespace scfloam
