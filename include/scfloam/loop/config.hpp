@@ -1,0 +1,39 @@
+// Loop detection parameters (keyframes, Scan Context, candidate search, distance gate) with
+// the defaults of ../shared/SPEC.md; docs/loop.md explains each and how they were chosen.
+#pragma once
+
+namespace scfloam {
+
+struct ScanContextConfig {
+  int num_rings = 20;             // radial bins up to max_radius_m
+  int num_sectors = 60;           // azimuth bins over 360 degrees (6 degrees each)
+  double max_radius_m = 80.0;     // points farther than this (horizontally) are ignored
+  double sensor_height_m = 2.0;   // added to z so that heights above the ground are positive
+};
+
+struct LoopDetectionConfig {
+  ScanContextConfig descriptor;
+
+  // A new keyframe after this much accumulated travel or rotation since the last one.
+  double keyframe_distance_m = 2.0;
+  double keyframe_angle_deg = 10.0;
+
+  // The paper's change: descriptor from the edge + plane feature clouds; false builds it
+  // from the raw scan (SC-A-LOAM / Simple-SC-F-LOAM baseline). The caller passes the points.
+  bool descriptor_from_features = true;
+
+  int exclude_recent_keyframes = 50;  // the newest keyframes are never loop candidates
+  int num_candidates = 10;            // ring-key nearest neighbours aligned per query
+  int tree_rebuild_every = 50;        // k-d tree rebuilt once this many keyframes are unindexed
+  double fine_search_ratio = 0.1;     // fine column-shift search: +- this fraction of sectors
+  double score_threshold = 0.2;       // accept a candidate whose column cosine distance is <= this
+
+  // Distance gate on current poses: d <= gate_base_m + k / gate_keyframes_per_m (paper eq. 1-3),
+  // or d <= fixed_gate_m when adaptive_gate is false (baseline).
+  bool adaptive_gate = true;
+  double gate_base_m = 20.0;
+  double gate_keyframes_per_m = 40.0;  // the paper's n
+  double fixed_gate_m = 1e9;           // effectively no gate (SC-A-LOAM) unless configured
+};
+
+}  // namespace scfloam
