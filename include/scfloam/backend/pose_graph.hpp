@@ -1,0 +1,96 @@
+// Keyframe pose graph on Ceres: nodes are keyframe poses T_world_kf, edges are measured
+// relative poses T_i_j (odometry between consecutive keyframes, loops from registration).
+//
+// Robustness against wrong loops, in two layers (docs/pose_graph.md):
+// - loop edges carry a Cauchy kernel in the final solve, so a mildly inconsistent loop pulls
+//   less;
+// - after a least-squares solve, a loop whose whitened residual is still beyond a chi-square bound is
+//   inconsistent with the odometry and the other loops: it is switched off and the graph is
+//   solved again. A bounded kernel alone cannot do this job: a genuine first loop after a long
+//   drive carries metres of discrepancy, which a tight kernel would treat as an outlier and
+//   leave the loop open.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <array>
+#include <filesystem>
+#include <vector>
+
+#include "scfloam/types.hpp"
+
+namespace scfloam {
+
+struct PoseGraphConfig {
+  // Odometry edge standard deviations per edge (the public code: variances 1e-6 rad^2, 1e-4 m^2).
+  double odometry_rotation_sigma_rad = 1e-3;
+  double odometry_translation_sigma_m = 1e-2;
+  // Loop edge standard deviations before the robust kernel (the public code: variance 0.5).
+  double loop_rotation_sigma_rad = 0.05;
+  double loop_translation_sigma_m = 0.1;
+  // Cauchy scale in whitened units: residuals well below it count quadratically.
+  double loop_cauchy_scale = 5.0;
+  // A loop whose squared whitened residual after solving exceeds this is switched off
+  // (chi-square, 6 dof: 22.46 is the 99.9 % quantile).
+  double loop_outlier_chi2 = 22.46;
+  int max_outlier_rounds = 3;
+  int max_iterations = 50;
+};
+
+struct PoseGraphEdge {
+  std::size_t from = 0, to = 0;
+  Eigen::Isometry3d T_from_to = Eigen::Isometry3d::Identity();
+  // Square root of the information matrix; the residual is [Log(R_err); t_err] of the error
+  // transform E = T_from_to^-1 * (T_world_from^-1 * T_world_to).
+  Eigen::Matrix<double, 6, 6> sqrt_information = Eigen::Matrix<double, 6, 6>::Identity();
+  bool is_loop = false;
+  bool active = true;  // false once the solver found the loop inconsistent
+};
+
+struct PoseGraphReport {
+  int iterations = 0;
+  double initial_cost = 0, final_cost = 0;
+  double solve_ms = 0;
+  bool converged = false;
+  std::vector<std::size_t> rejected_edges;  // indices into edges() switched off by this solve
+};
+
+// Square-root information for independent rotation/translation sigmas.
+Eigen::Matrix<double, 6, 6> sqrt_information_from_sigmas(double rotation_sigma_rad,
+                                                         double translation_sigma_m);
+
+class PoseGraph {
+ public:
+  // Adds a node with its initial estimate; returns its index.
+  std::size_t add_node(const Eigen::Isometry3d& T_world_node);
+  void add_edge(const PoseGraphEdge& edge);
+  // Convenience: edges with the config's sigmas.
+  void add_odometry_edge(std::size_t from, std::size_t to, const Eigen::Isometry3d& T_from_to,
+                         const PoseGraphConfig& config);
+  void add_loop_edge(std::size_t from, std::size_t to, const Eigen::Isometry3d& T_from_to,
+                     const PoseGraphConfig& config);
+
+  // Optimizes all nodes with node 0 held fixed (the map's origin).
+  PoseGraphReport optimize(const PoseGraphConfig& config);
+
+  std::size_t size() const { return nodes_.size(); }
+  Eigen::Isometry3d pose(std::size_t node) const;
+  PoseList poses() const;
+  const std::vector<PoseGraphEdge>& edges() const { return edges_; }
+  // Squared whitened residual of an edge under the current estimate.
+  double edge_chi2(std::size_t edge) const;
+  std::size_t loop_edge_count() const;
+
+  // g2o text format (VERTEX_SE3:QUAT / EDGE_SE3:QUAT, information in g2o's [t, r] order),
+  // readable by g2o and GTSAM's readG2o. Written atomically.
+  void write_g2o(const std::filesystem::path& path) const;
+
+ private:
+  // One parameter block per node: [tx ty tz qx qy qz qw] (Eigen's quaternion storage order).
+  std::vector<std::array<double, 7>> nodes_;
+  std::vector<PoseGraphEdge> edges_;
+
+  PoseGraphReport solve_once(const PoseGraphConfig& config, bool robust);
+};
+
+}  // namespace scfloam

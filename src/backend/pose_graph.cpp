@@ -1,0 +1,193 @@
+#include "scfloam/backend/pose_graph.hpp"
+
+#include <ceres/ceres.h>
+
+#include <cstdio>
+
+#include "backend/pose_graph_costs.hpp"
+#include "scfloam/atomic_file.hpp"
+#include "scfloam/error.hpp"
+#include "scfloam/se3.hpp"
+#include "scfloam/stats.hpp"
+
+namespace scfloam {
+using namespace pose_graph_detail;
+
+Eigen::Matrix<double, 6, 6> sqrt_information_from_sigmas(double rotation_sigma_rad,
+                                                         double translation_sigma_m) {
+  Matrix6d m = Matrix6d::Zero();
+  m.diagonal().head<3>().setConstant(1.0 / rotation_sigma_rad);
+  m.diagonal().tail<3>().setConstant(1.0 / translation_sigma_m);
+  return m;
+}
+
+std::size_t PoseGraph::add_node(const Eigen::Isometry3d& T_world_node) {
+  const Eigen::Quaterniond q = Eigen::Quaterniond(T_world_node.linear()).normalized();
+  const Eigen::Vector3d t = T_world_node.translation();
+  nodes_.push_back({t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w()});
+  return nodes_.size() - 1;
+}
+
+void PoseGraph::add_edge(const PoseGraphEdge& edge) {
+  if (edge.from >= size() || edge.to >= size() || edge.from == edge.to)
+    throw Error("pose graph: edge " + std::to_string(edge.from) + " -> " +
+                std::to_string(edge.to) + " does not join two distinct existing nodes");
+  edges_.push_back(edge);
+}
+
+void PoseGraph::add_odometry_edge(std::size_t from, std::size_t to,
+                                  const Eigen::Isometry3d& T_from_to,
+                                  const PoseGraphConfig& config) {
+  add_edge({from, to, T_from_to,
+            sqrt_information_from_sigmas(config.odometry_rotation_sigma_rad,
+                                         config.odometry_translation_sigma_m),
+            false});
+}
+
+void PoseGraph::add_loop_edge(std::size_t from, std::size_t to, const Eigen::Isometry3d& T_from_to,
+                              const PoseGraphConfig& config) {
+  add_edge({from, to, T_from_to,
+            sqrt_information_from_sigmas(config.loop_rotation_sigma_rad,
+                                         config.loop_translation_sigma_m),
+            true});
+}
+
+std::size_t PoseGraph::loop_edge_count() const {
+  std::size_t n = 0;
+  for (const auto& e : edges_) n += e.is_loop && e.active;
+  return n;
+}
+
+double PoseGraph::edge_chi2(std::size_t edge) const {
+  const PoseGraphEdge& e = edges_.at(edge);
+  const RelativePoseCost cost(e.T_from_to, e.sqrt_information);
+  const double* params[2] = {nodes_[e.from].data(), nodes_[e.to].data()};
+  Vector6d r;
+  cost.Evaluate(params, r.data(), nullptr);
+  return r.squaredNorm();
+}
+
+PoseGraphReport PoseGraph::optimize(const PoseGraphConfig& config) {
+  Stopwatch watch;
+  // Least squares first: a bounded kernel from the drifted start would treat a genuine first
+  // loop (metres of discrepancy) as an outlier. Inconsistent loops are pruned, then the
+  // Cauchy kernel polishes from the closed configuration, where true loops fit well.
+  PoseGraphReport report = solve_once(config, /*robust=*/false);
+  const double polish_chi2 = 0.25 * config.loop_cauchy_scale * config.loop_cauchy_scale;
+  bool needs_polish = false;
+  for (int round = 0; round <= config.max_outlier_rounds; ++round) {
+    // Switch off the worst inconsistent loop only: one false loop can make its true
+    // neighbours look bad until it is gone.
+    std::size_t worst = edges_.size();
+    double worst_chi2 = config.loop_outlier_chi2;
+    needs_polish = false;
+    for (std::size_t i = 0; i < edges_.size(); ++i) {
+      if (!edges_[i].is_loop || !edges_[i].active) continue;
+      const double chi2 = edge_chi2(i);
+      needs_polish |= chi2 > polish_chi2;
+      if (chi2 > worst_chi2) {
+        worst_chi2 = chi2;
+        worst = i;
+      }
+    }
+    if (worst == edges_.size() || round == config.max_outlier_rounds) break;
+    edges_[worst].active = false;
+    report.rejected_edges.push_back(worst);
+    report.iterations += solve_once(config, false).iterations;
+  }
+  // Where every loop fits well within the kernel's scale the Cauchy solution is the
+  // least-squares one to within tolerance: skip the extra solve.
+  if (needs_polish) {
+    const PoseGraphReport polished = solve_once(config, true);
+    report.iterations += polished.iterations;
+    report.final_cost = polished.final_cost;
+    report.converged = polished.converged;
+  }
+  report.solve_ms = watch.elapsed_ms();
+  return report;
+}
+
+PoseGraphReport PoseGraph::solve_once(const PoseGraphConfig& config, bool robust) {
+  PoseGraphReport report;
+  if (size() < 2 || edges_.empty()) return report;
+  ceres::Problem::Options problem_options;
+  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem problem(problem_options);
+  PoseManifold manifold;
+  ceres::CauchyLoss loop_loss(config.loop_cauchy_scale);
+  for (const auto& e : edges_) {
+    if (!e.active) continue;
+    problem.AddResidualBlock(new RelativePoseCost(e.T_from_to, e.sqrt_information),
+                             e.is_loop && robust ? &loop_loss : nullptr, nodes_[e.from].data(),
+                             nodes_[e.to].data());
+  }
+  for (auto& node : nodes_)
+    if (problem.HasParameterBlock(node.data())) problem.SetManifold(node.data(), &manifold);
+  // Node 0 anchors the map (gauge freedom).
+  if (problem.HasParameterBlock(nodes_[0].data())) problem.SetParameterBlockConstant(nodes_[0].data());
+  ceres::Solver::Options options;
+  options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+  options.max_num_iterations = config.max_iterations;
+  options.num_threads = 1;  // the other core runs the odometry
+  ceres::Solver::Summary summary;
+  ceres::Solve(options, &problem, &summary);
+  report.iterations = static_cast<int>(summary.iterations.size());
+  report.initial_cost = summary.initial_cost;
+  report.final_cost = summary.final_cost;
+  report.converged = summary.termination_type == ceres::CONVERGENCE;
+  return report;
+}
+
+Eigen::Isometry3d PoseGraph::pose(std::size_t node) const {
+  const double* x = nodes_.at(node).data();
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = node_rotation(x).normalized().toRotationMatrix();
+  T.translation() = node_position(x);
+  return T;
+}
+
+PoseList PoseGraph::poses() const {
+  PoseList out;
+  out.reserve(size());
+  for (std::size_t i = 0; i < size(); ++i) out.push_back(pose(i));
+  return out;
+}
+
+void PoseGraph::write_g2o(const std::filesystem::path& path) const {
+  write_file_atomic(path, [&](std::ostream& out) {
+    char buf[512];
+    for (std::size_t i = 0; i < size(); ++i) {
+      const double* x = nodes_[i].data();
+      std::snprintf(buf, sizeof buf, "VERTEX_SE3:QUAT %zu %.9f %.9f %.9f %.9f %.9f %.9f %.9f\n", i,
+                    x[0], x[1], x[2], x[3], x[4], x[5], x[6]);
+      out << buf;
+    }
+    if (size() > 0) out << "FIX 0\n";
+    // Our residual is [rotation; translation]; g2o orders its information [translation; rotation]
+    // and measures rotation error as vec(q) ~ Log(R) / 2, hence the factor 2 on rotation rows.
+    Matrix6d to_g2o = Matrix6d::Zero();
+    to_g2o.block<3, 3>(0, 3).setIdentity();
+    to_g2o.block<3, 3>(3, 0) = 2.0 * Eigen::Matrix3d::Identity();
+    for (const auto& e : edges_) {
+      if (!e.active) continue;
+      const Eigen::Vector3d t = e.T_from_to.translation();
+      const Eigen::Quaterniond q(e.T_from_to.linear());
+      // Information in our residual r = P r_g2o, so Omega_g2o = P^T Omega P.
+      const Matrix6d omega = e.sqrt_information.transpose() * e.sqrt_information;
+      const Matrix6d P = to_g2o.transpose();  // r_ours = P * r_g2o
+      const Matrix6d info = P.transpose() * omega * P;
+      std::snprintf(buf, sizeof buf, "EDGE_SE3:QUAT %zu %zu %.9f %.9f %.9f %.9f %.9f %.9f %.9f",
+                    e.from, e.to, t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
+      out << buf;
+      for (int r = 0; r < 6; ++r)
+        for (int c = r; c < 6; ++c) {
+          std::snprintf(buf, sizeof buf, " %.9g", info(r, c));
+          out << buf;
+        }
+      out << "\n";
+    }
+  });
+}
+
+}  // namespace scfloam
