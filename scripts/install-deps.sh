@@ -7,6 +7,7 @@ packages=(
   libeigen3-dev libceres-dev libnanoflann-dev libtbb-dev libyaml-cpp-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev libpng-dev zlib1g-dev nlohmann-json3-dev
   libsqlite3-dev libzstd-dev liblz4-dev
+  libopen3d-dev
   python3 python3-matplotlib python3-numpy
 )
 missing=()

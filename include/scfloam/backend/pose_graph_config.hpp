@@ -1,0 +1,23 @@
+// Pose graph parameters (docs/parameters.md); kept apart from pose_graph.hpp so that the
+// whole configuration can be included without Ceres or Eigen.
+#pragma once
+
+namespace scfloam {
+
+struct PoseGraphConfig {
+  // Odometry edge standard deviations per edge (the public code: variances 1e-6 rad^2, 1e-4 m^2).
+  double odometry_rotation_sigma_rad = 1e-3;
+  double odometry_translation_sigma_m = 1e-2;
+  // Loop edge standard deviations before the robust kernel (the public code: variance 0.5).
+  double loop_rotation_sigma_rad = 0.05;
+  double loop_translation_sigma_m = 0.1;
+  // Cauchy scale in whitened units: residuals well below it count quadratically.
+  double loop_cauchy_scale = 5.0;
+  // A loop whose squared whitened residual after solving exceeds this is switched off
+  // (chi-square, 6 dof: 22.46 is the 99.9 % quantile).
+  double loop_outlier_chi2 = 22.46;
+  int max_outlier_rounds = 3;
+  int max_iterations = 50;
+};
+
+}  // namespace scfloam

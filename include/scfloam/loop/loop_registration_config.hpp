@@ -1,0 +1,23 @@
+// Loop registration parameters (docs/parameters.md).
+#pragma once
+
+namespace scfloam {
+
+struct LoopRegistrationConfig {
+  int submap_neighbors = 25;  // keyframes each side of the loop keyframe in the submap
+  // Feature registration: correspondence rounds (the loop starts farther off than a frame).
+  int rounds = 10;
+  // A match is accepted when at least this fraction of the current features found a line or
+  // plane in the submap and their mean distance is below max_mean_residual_m.
+  double min_inlier_fraction = 0.45;
+  double max_mean_residual_m = 0.08;
+  // ICP baseline, SC-A-LOAM's parameters: Open3D point-to-point ICP on clouds downsampled at
+  // icp_leaf_m; accepted when the mean squared correspondence distance (PCL's "fitness
+  // score") is below icp_max_fitness_m2.
+  double icp_leaf_m = 0.4;
+  double icp_max_correspondence_m = 150.0;
+  int icp_max_iterations = 100;
+  double icp_max_fitness_m2 = 0.3;
+};
+
+}  // namespace scfloam
