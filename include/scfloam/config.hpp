@@ -5,6 +5,10 @@
 #include <filesystem>
 #include <string>
 
+#include "scfloam/backend/pose_graph_config.hpp"
+#include "scfloam/loop/config.hpp"
+#include "scfloam/loop/loop_registration_config.hpp"
+
 namespace scfloam {
 
 // Range crop and motion compensation of the raw scan.
@@ -63,7 +67,7 @@ struct RegistrationConfig {
 struct LocalMapConfig {
   double edge_spacing_m = 0.4;   // a new map point closer than this to a stored one is dropped
   double plane_spacing_m = 0.8;
-  int max_points_per_cell = 20;  // hash cells are 2 * max_neighbor_dist_m wide
+  int max_points_per_cell = 20;  // hash cells are max_neighbor_dist_m wide
   double radius_m = 100.0;       // cells farther than this from the pose are removed
 };
 
@@ -75,8 +79,22 @@ struct OdometryConfig {
   LocalMapConfig map;
 };
 
+// How the three stages are joined.
+struct PipelineConfig {
+  // Loop work done in frame order on the odometry's thread: the same input gives the same
+  // output (tests, evaluation). Otherwise the stages run on their own threads.
+  bool deterministic = false;
+  int queue_capacity = 256;        // keyframes waiting between stages
+  bool rebuild_map_after_loop = true;  // the odometry continues on the corrected map
+  double raw_leaf_m = 0.4;         // raw keyframe clouds (baseline descriptor, ICP) downsampling
+};
+
 struct SlamConfig {
   OdometryConfig odometry;
+  LoopDetectionConfig loop_detection;
+  LoopRegistrationConfig loop_registration;
+  PoseGraphConfig pose_graph;
+  PipelineConfig pipeline;
 };
 
 // Reads a YAML file; unknown keys and wrong types are errors naming the file and the key.

@@ -1,14 +1,27 @@
+// The three stages of the paper, joined by bounded queues:
+//   odometry (this thread) -> loop detection (thread) -> loop registration + pose graph (thread)
+// Corrected keyframe poses flow back through the KeyframeStore: the odometry re-anchors its
+// local map on them, the detector's distance gate uses them.
 #include "scfloam/pipeline/pipeline.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <exception>
 #include <thread>
+#include <utility>
 
+#include "pipeline/keyframe_store.hpp"
+#include "pipeline/loop_closure.hpp"
+#include "scfloam/backend/pose_graph.hpp"
 #include "scfloam/bounded_queue.hpp"
 #include "scfloam/error.hpp"
+#include "scfloam/loop/keyframe_selector.hpp"
+#include "scfloam/loop/loop_detector.hpp"
 #include "scfloam/odometry/odometry.hpp"
 #include "scfloam/progress.hpp"
+#include "scfloam/registration/voxel_filter.hpp"
+#include "scfloam/se3.hpp"
 #include "scfloam/stats.hpp"
 
 namespace scfloam {
@@ -45,38 +58,261 @@ class ScanPrefetcher {
   std::thread thread_;
 };
 
+// What each mode changes in the configuration (the paper's Table I methods).
+SlamConfig configure_for_mode(SlamConfig config, SlamMode mode) {
+  if (mode == SlamMode::kSimpleSc) {
+    config.loop_detection.descriptor_from_features = false;
+    config.loop_detection.adaptive_gate = false;
+  } else if (mode == SlamMode::kOptimized) {
+    config.loop_detection.descriptor_from_features = true;
+    config.loop_detection.adaptive_gate = true;
+  }
+  return config;
+}
+
+FeatureCloud downsampled_raw(const Scan& scan, double leaf_m, VoxelFilter& filter) {
+  FeatureCloud points, out;
+  points.reserve(scan.points.size());
+  for (const auto& p : scan.points) points.emplace_back(p.x, p.y, p.z);
+  filter.filter(points, leaf_m, out);
+  return out;
+}
+
+struct DetectedKeyframe {
+  KeyframePtr keyframe;
+  LoopQuery query;
+};
+
+// Loop detection for one keyframe, with the gate on the best current poses.
+class DetectionStage {
+ public:
+  DetectionStage(const LoopDetectionConfig& config, const KeyframeStore& store)
+      : detector_(config), store_(store) {}
+
+  LoopQuery detect(const KeyframePtr& kf) {
+    Stopwatch watch;
+    if (store_.version() != seen_version_) {
+      seen_version_ = store_.version();
+      PoseList poses = store_.current_poses();
+      poses.resize(std::min(poses.size(), detector_.size()));
+      detector_.update_poses(poses);
+    }
+    const Eigen::Isometry3d T_world_kf = store_.current_pose(kf->index);
+    LoopQuery query =
+        detector_.config().descriptor_from_features
+            ? detector_.add_keyframe(static_cast<std::int64_t>(kf->frame), T_world_kf, kf->edges,
+                                     kf->planes)
+            : detector_.add_keyframe(static_cast<std::int64_t>(kf->frame), T_world_kf, kf->raw);
+    ms_.push_back(watch.elapsed_ms());
+    return query;
+  }
+  const std::vector<double>& ms() const { return ms_; }
+
+ private:
+  LoopDetector detector_;
+  const KeyframeStore& store_;
+  std::uint64_t seen_version_ = 0;
+  std::vector<double> ms_;
+};
+
+// Loop detection and loop closure on their own threads, fed keyframe by keyframe.
+class LoopThreads {
+ public:
+  LoopThreads(DetectionStage& detection, LoopClosure& closure, int capacity)
+      : to_detection_(capacity), to_closure_(capacity) {
+    detection_thread_ = std::thread([this, &detection] {
+      guarded([&] {
+        while (auto kf = to_detection_.pop())
+          to_closure_.push({*kf, detection.detect(*kf)});
+      });
+      to_closure_.close();
+    });
+    closure_thread_ = std::thread([this, &closure] {
+      guarded([&] {
+        while (auto item = to_closure_.pop()) closure.add(item->keyframe, item->query);
+      });
+    });
+  }
+  ~LoopThreads() { finish(); }
+
+  void push(KeyframePtr kf) { to_detection_.push(std::move(kf)); }
+  // Waits for every keyframe to be handled; rethrows a stage's error.
+  void finish() {
+    to_detection_.close();
+    if (detection_thread_.joinable()) detection_thread_.join();
+    if (closure_thread_.joinable()) closure_thread_.join();
+    if (error_) std::rethrow_exception(std::exchange(error_, nullptr));
+  }
+
+ private:
+  template <typename F>
+  void guarded(F&& work) {
+    try {
+      work();
+    } catch (...) {
+      std::lock_guard<std::mutex> lock(error_mutex_);
+      if (!error_) error_ = std::current_exception();
+      to_detection_.close();
+      to_closure_.close();
+    }
+  }
+
+  BoundedQueue<KeyframePtr> to_detection_;
+  BoundedQueue<DetectedKeyframe> to_closure_;
+  std::thread detection_thread_, closure_thread_;
+  std::mutex error_mutex_;
+  std::exception_ptr error_;
+};
+
+// The odometry's side: keyframe selection, re-anchoring on corrected poses, per-frame anchors.
+class OdometryStage {
+ public:
+  OdometryStage(const SlamConfig& config, KeyframeStore& store, bool loops)
+      : config_(config),
+        store_(store),
+        loops_(loops),
+        odometry_(config.odometry),
+        selector_(config.loop_detection.keyframe_distance_m,
+                  config.loop_detection.keyframe_angle_deg * M_PI / 180.0) {}
+
+  // Processes one scan; returns the new keyframe, if this scan made one.
+  KeyframePtr process(std::size_t frame, const Scan& scan, RunResult& result) {
+    if (loops_ && store_.version() != seen_version_) reanchor();
+    const OdometryResult odom = odometry_.process(scan);
+    // The odometry's own chain of relative motions: its trajectory before any correction.
+    const Eigen::Isometry3d T_last_current = has_last_ ? T_world_last_.inverse() * odom.T_world_lidar
+                                                       : Eigen::Isometry3d::Identity();
+    T_chain_ = orthonormalized(T_chain_ * T_last_current);
+    T_world_last_ = odom.T_world_lidar;
+    has_last_ = true;
+    result.stamps_s.push_back(scan.timestamp_s);
+    result.odometry_T_world_lidar.push_back(T_chain_);
+    result.timing_ms["features"].push_back(odom.features_ms);
+    result.timing_ms["registration"].push_back(odom.registration_ms);
+    if (odom.degenerate) ++result.degenerate_frames;
+
+    KeyframePtr made;
+    if (selector_.update(T_chain_)) {
+      auto kf = std::make_shared<Keyframe>();
+      kf->index = kf_poses_.size();
+      kf->frame = frame;
+      kf->T_prev_current = kf_poses_.empty() ? Eigen::Isometry3d::Identity()
+                                             : kf_poses_.back().inverse() * odom.T_world_lidar;
+      kf->edges = odom.edges;
+      kf->planes = odom.planes;
+      if (loops_ && !config_.loop_detection.descriptor_from_features)
+        kf->raw = downsampled_raw(scan, config_.pipeline.raw_leaf_m, raw_filter_);
+      kf_poses_.push_back(odom.T_world_lidar);
+      result.keyframe_frames.push_back(frame);
+      store_.add(kf);  // the map is assembled from keyframes in every mode
+      made = kf;
+    }
+    anchors_.push_back({kf_poses_.size() - 1, kf_poses_.back().inverse() * odom.T_world_lidar});
+    return made;
+  }
+
+  // Every frame placed on its keyframe's final pose.
+  PoseList final_poses(const PoseList& keyframe_poses) const {
+    PoseList out;
+    out.reserve(anchors_.size());
+    for (const auto& [kf, T_kf_frame] : anchors_) out.push_back(keyframe_poses.at(kf) * T_kf_frame);
+    return out;
+  }
+
+ private:
+  // The graph moved the keyframes: move the odometry's frame with them and rebuild its local
+  // map from the corrected keyframes around the current position.
+  void reanchor() {
+    seen_version_ = store_.version();
+    const PoseList corrected = store_.current_poses();
+    if (corrected.size() != kf_poses_.size() || kf_poses_.empty()) return;  // cannot happen
+    const Eigen::Isometry3d correction = corrected.back() * kf_poses_.back().inverse();
+    const Eigen::Isometry3d T_world_now = orthonormalized(correction * T_world_last_);
+    kf_poses_ = corrected;
+    T_world_last_ = T_world_now;
+    if (!config_.pipeline.rebuild_map_after_loop) return;
+    std::vector<std::pair<Eigen::Isometry3d, const FeatureCloud*>> edges, planes;
+    std::vector<KeyframePtr> keep;
+    const double radius = config_.odometry.map.radius_m;
+    for (std::size_t i = 0; i < corrected.size(); ++i) {
+      if ((corrected[i].translation() - T_world_now.translation()).norm() > radius) continue;
+      keep.push_back(store_.get(i));
+      edges.emplace_back(corrected[i], &keep.back()->edges);
+      planes.emplace_back(corrected[i], &keep.back()->planes);
+    }
+    odometry_.reset_map(edges, planes, T_world_now);
+  }
+
+  const SlamConfig& config_;
+  KeyframeStore& store_;
+  bool loops_;
+  Odometry odometry_;
+  KeyframeSelector selector_;
+  VoxelFilter raw_filter_;
+  std::uint64_t seen_version_ = 0;
+  PoseList kf_poses_;  // keyframe poses in the odometry's current frame
+  std::vector<std::pair<std::size_t, Eigen::Isometry3d>> anchors_;  // per frame: kf, T_kf_frame
+  Eigen::Isometry3d T_world_last_ = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d T_chain_ = Eigen::Isometry3d::Identity();
+  bool has_last_ = false;
+};
+
 }  // namespace
 
-RunResult run_slam(const ScanSource& source, const SlamConfig& config, const RunOptions& options) {
-  if (options.mode != SlamMode::kOdometry)
-    throw Error("mode '" + mode_name(options.mode) +
-                "' is not available yet: loop closure lands with the loop issues; use --mode odometry");
+RunResult run_slam(const ScanSource& source, const SlamConfig& base_config,
+                   const RunOptions& options) {
   const std::size_t count =
       options.max_frames ? std::min(options.max_frames, source.size()) : source.size();
   if (count == 0) throw Error("the input has no scans: " + source.describe());
+  const SlamConfig config = configure_for_mode(base_config, options.mode);
+  const bool loops = options.mode != SlamMode::kOdometry;
+  const bool deterministic = config.pipeline.deterministic || options.deterministic;
 
   RunResult result;
   result.mode = options.mode;
   Stopwatch wall;
-  Odometry odometry(config.odometry);
+  KeyframeStore store;
+  OdometryStage odometry(config, store, loops);
+  DetectionStage detection(config.loop_detection, store);
+  LoopClosure closure(config,
+                      options.mode == SlamMode::kSimpleSc ? LoopRegistrationMethod::kIcp
+                                                          : LoopRegistrationMethod::kFeatures,
+                      store);
+  std::optional<LoopThreads> threads;
+  if (loops && !deterministic) threads.emplace(detection, closure, config.pipeline.queue_capacity);
+
   ScanPrefetcher prefetcher(source, count);
-  ProgressBar progress("odometry", count, options.progress);
-  auto& features_ms = result.timing_ms["features"];
-  auto& registration_ms = result.timing_ms["registration"];
+  ProgressBar progress(mode_name(options.mode), count, options.progress);
   while (auto item = prefetcher.next()) {
     const auto& [index, scan] = *item;
-    const OdometryResult odom = odometry.process(scan);
-    result.stamps_s.push_back(scan.timestamp_s);
-    result.odometry_T_world_lidar.push_back(odom.T_world_lidar);
-    features_ms.push_back(odom.features_ms);
-    registration_ms.push_back(odom.registration_ms);
-    if (odom.degenerate) ++result.degenerate_frames;
-    progress.update(index + 1, std::to_string(static_cast<int>(odom.features_ms +
-                                                               odom.registration_ms + 0.5)) +
-                                   " ms/frame");
+    KeyframePtr kf = odometry.process(index, scan, result);
+    if (kf && loops) {
+      if (threads) {
+        threads->push(std::move(kf));
+      } else {
+        closure.add(kf, detection.detect(kf));
+      }
+    }
+    const auto& f = result.timing_ms["features"];
+    const auto& r = result.timing_ms["registration"];
+    char note[64];
+    std::snprintf(note, sizeof note, "%.1f ms/frame, %zu loops", f.back() + r.back(),
+                  closure.accepted_loops());
+    progress.update(index + 1, note);
   }
+  if (threads) threads->finish();
   progress.finish();
-  result.T_world_lidar = result.odometry_T_world_lidar;
+
+  result.keyframe_poses = store.current_poses();
+  result.T_world_lidar = odometry.final_poses(result.keyframe_poses);
+  for (std::size_t i = 0; i < store.size(); ++i) result.keyframes.push_back(store.get(i));
+  if (loops) {
+    result.timing_ms["loop_detection"] = detection.ms();
+    result.timing_ms["loop_registration"] = closure.registration_ms();
+    result.timing_ms["optimization"] = closure.optimization_ms();
+    result.loop_rows = closure.log().rows();
+    result.graph = std::make_shared<PoseGraph>(closure.graph());
+  }
   result.wall_s = wall.elapsed_ms() / 1000.0;
   return result;
 }

@@ -3,12 +3,15 @@
 
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "scfloam/config.hpp"
 #include "scfloam/io/scan_source.hpp"
+#include "scfloam/loop/loop_candidate.hpp"
+#include "scfloam/pipeline/keyframe.hpp"
 #include "scfloam/types.hpp"
 
 namespace scfloam {
@@ -26,7 +29,10 @@ struct RunOptions {
   SlamMode mode = SlamMode::kOdometry;
   std::size_t max_frames = 0;  // 0: every scan of the source
   bool progress = true;        // progress bar on stderr
+  bool deterministic = false;  // loop work in frame order on one thread (also a config key)
 };
+
+class PoseGraph;
 
 struct RunResult {
   SlamMode mode = SlamMode::kOdometry;
@@ -38,6 +44,12 @@ struct RunResult {
   // Per-stage samples in milliseconds ("features", "registration", ...).
   std::map<std::string, std::vector<double>> timing_ms;
   double wall_s = 0;
+  // Loop modes only: every loop candidate with its verdict, the final graph, the keyframes
+  // with their final poses.
+  std::vector<LoopCandidate> loop_rows;
+  std::shared_ptr<const PoseGraph> graph;
+  std::vector<KeyframePtr> keyframes;
+  PoseList keyframe_poses;
 };
 
 RunResult run_slam(const ScanSource& source, const SlamConfig& config, const RunOptions& options);

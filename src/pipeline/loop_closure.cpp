@@ -1,0 +1,70 @@
+#include "pipeline/loop_closure.hpp"
+
+#include "scfloam/stats.hpp"
+
+namespace scfloam {
+
+LoopClosure::LoopClosure(const SlamConfig& config, LoopRegistrationMethod method,
+                         KeyframeStore& store)
+    : config_(config), method_(method), store_(store) {}
+
+std::vector<KeyframeView> LoopClosure::submap_around(std::size_t loop_kf, std::size_t limit,
+                                                     std::size_t& loop_index) const {
+  const int n = config_.loop_registration.submap_neighbors;
+  const std::size_t first = loop_kf > static_cast<std::size_t>(n) ? loop_kf - n : 0;
+  const std::size_t last = std::min(limit, loop_kf + n + 1);
+  std::vector<KeyframeView> submap;
+  for (std::size_t i = first; i < last; ++i) {
+    const KeyframePtr kf = store_.get(i);
+    submap.push_back({graph_.pose(i), &kf->edges, &kf->planes, &kf->raw});
+    if (i == loop_kf) loop_index = submap.size() - 1;
+  }
+  return submap;
+}
+
+bool LoopClosure::add(const KeyframePtr& keyframe, const LoopQuery& query) {
+  const std::size_t k = keyframe->index;
+  graph_.add_node(store_.current_pose(k));
+  if (k > 0) graph_.add_odometry_edge(k - 1, k, keyframe->T_prev_current, config_.pose_graph);
+  const std::optional<std::size_t> row = log_.add(query);
+  if (!query.best || !row) return false;
+
+  // Register the current keyframe to the loop keyframe's submap, at the current estimates.
+  Stopwatch watch;
+  const std::size_t loop_kf = static_cast<std::size_t>(query.best->loop_kf);
+  std::size_t loop_index = 0;
+  // The submap stops short of the recent keyframes, which are never loop partners.
+  const std::vector<KeyframeView> submap = submap_around(loop_kf, k, loop_index);
+  const KeyframeView current{graph_.pose(k), &keyframe->edges, &keyframe->planes, &keyframe->raw};
+  const LoopMatch match =
+      method_ == LoopRegistrationMethod::kFeatures
+          ? register_loop_features(current, submap, loop_index, query.best->yaw_rad,
+                                   config_.loop_registration, config_.odometry.registration,
+                                   config_.odometry.map)
+          : register_loop_icp(current, submap, loop_index, query.best->yaw_rad,
+                              config_.loop_registration);
+  registration_ms_.push_back(watch.elapsed_ms());
+  log_.set_match(*row, match.accepted ? LoopVerdict::kAccepted : LoopVerdict::kRejectedMatch,
+                 match.inlier_fraction, match.residual_m);
+  if (!match.accepted) return false;
+
+  // Edge from the current keyframe to the loop keyframe.
+  graph_.add_loop_edge(k, loop_kf, match.T_loop_current.inverse(), config_.pose_graph);
+  loop_rows_.push_back(*row);
+  watch.restart();
+  const PoseGraphReport report = graph_.optimize(config_.pose_graph);
+  optimization_ms_.push_back(watch.elapsed_ms());
+  // Loops the graph found inconsistent are recorded as rejected in the log.
+  for (std::size_t edge : report.rejected_edges) {
+    std::size_t loop_number = 0;
+    for (std::size_t e = 0; e < edge; ++e) loop_number += graph_.edges()[e].is_loop;
+    const auto& logged = log_.rows()[loop_rows_.at(loop_number)];
+    log_.set_match(loop_rows_[loop_number], LoopVerdict::kRejectedMatch,
+                   logged.match_inlier_fraction, logged.match_residual_m);
+  }
+  accepted_ = graph_.loop_edge_count();
+  store_.set_optimized(graph_.poses());
+  return true;
+}
+
+}  // namespace scfloam

@@ -1,0 +1,48 @@
+// The third stage: keyframes become pose-graph nodes; a proposed loop is registered (features
+// or ICP, by mode), checked, added as a robust edge, and the graph re-optimized. Corrected
+// poses go to the keyframe store, where the other stages pick them up.
+#pragma once
+
+#include <atomic>
+#include <vector>
+
+#include "pipeline/keyframe_store.hpp"
+#include "scfloam/backend/pose_graph.hpp"
+#include "scfloam/config.hpp"
+#include "scfloam/loop/loop_detector.hpp"
+#include "scfloam/loop/loop_registration.hpp"
+#include "scfloam/loop/loops_csv.hpp"
+
+namespace scfloam {
+
+enum class LoopRegistrationMethod { kFeatures, kIcp };
+
+class LoopClosure {
+ public:
+  LoopClosure(const SlamConfig& config, LoopRegistrationMethod method, KeyframeStore& store);
+
+  // Adds keyframe `keyframe` (already in the store) and handles the loop its query proposed.
+  // Returns true when the graph was re-optimized (the store then holds corrected poses).
+  bool add(const KeyframePtr& keyframe, const LoopQuery& query);
+
+  const LoopLog& log() const { return log_; }
+  const PoseGraph& graph() const { return graph_; }
+  std::size_t accepted_loops() const { return accepted_.load(); }  // any thread
+  const std::vector<double>& registration_ms() const { return registration_ms_; }
+  const std::vector<double>& optimization_ms() const { return optimization_ms_; }
+
+ private:
+  std::vector<KeyframeView> submap_around(std::size_t loop_kf, std::size_t limit,
+                                          std::size_t& loop_index) const;
+
+  const SlamConfig& config_;
+  LoopRegistrationMethod method_;
+  KeyframeStore& store_;
+  PoseGraph graph_;
+  LoopLog log_;
+  std::vector<std::size_t> loop_rows_;  // loops.csv row of each loop edge, in edge order
+  std::atomic<std::size_t> accepted_{0};
+  std::vector<double> registration_ms_, optimization_ms_;
+};
+
+}  // namespace scfloam
