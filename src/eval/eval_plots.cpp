@@ -13,9 +13,9 @@
 namespace scfloam {
 namespace {
 
-const svg::Style kGtStyle{"#222222", 1.6, "", 1.0};
-const svg::Style kEstStyle{"#1f77b4", 1.6, "", 1.0};
-const svg::Style kLoopStyle{"#d62728", 1.0, "", 0.7};
+const svg::Style kGtStyle{"#222222", 2.4, "", 1.0};  // wider: visible under an exact estimate
+const svg::Style kEstStyle{"#1f77b4", 1.4, "", 1.0};
+const svg::Style kLoopStyle{"#d62728", 1.3, "", 0.8};
 const svg::Style kRotStyle{"#ff7f0e", 1.8, "", 1.0};
 const svg::Style kStartStyle{"#2ca02c", 1.0, "", 1.0};
 
@@ -96,7 +96,7 @@ void draw_length_panel(svg::Canvas& canvas, double top_px, const KittiMetric& m,
   }
   svg::Panel p(canvas, 960, top_px, 500, 190);
   const double y_max = ly.empty() ? 1.0 : *std::max_element(ly.begin(), ly.end());
-  p.set_range(50, 850, 0, y_max > 0 ? 1.15 * y_max : 1.0);
+  p.set_range(50, 850, 0, y_max > 0 ? 1.35 * y_max : 1.0);  // headroom for the legend
   p.draw_axes(rotation ? "Rotation error vs segment length" : "Translation error vs segment length",
               "segment length [m]", rotation ? "r_err [deg/100 m]" : "t_err [%]");
   if (ly.empty()) {
@@ -120,7 +120,8 @@ void draw_frame_error(svg::Canvas& canvas, double top_px, const EvalPlotInput& i
   const auto& err = in.report->ate.errors_m;
   svg::Panel p(canvas, 960, top_px, 500, 190);
   const double e_max = *std::max_element(err.begin(), err.end());
-  p.set_range(0, std::max(dist.back(), 1.0), 0, e_max > 0 ? 1.15 * e_max : 1.0);
+  // At least 1 cm tall, so round-off errors of an exact estimate look like the zero they are.
+  p.set_range(0, std::max(dist.back(), 1.0), 0, std::max(1.35 * e_max, 0.01));
   p.draw_axes("Per-frame translation error (ATE, aligned)", "distance along ground truth [m]",
               "error [m]");
   p.polyline(dist, err, kEstStyle);
@@ -145,10 +146,10 @@ std::string eval_plot_svg(const EvalPlotInput& in) {
   svg::Canvas canvas(1500, 880);
   const auto& r = *in.report;
   canvas.text(750, 26,
-              (in.heading.empty() ? std::string() : in.heading + "   ") + "t_err " +
-                  fmt("%.3f %%", r.kitti.t_err_pct) + "   r_err " +
-                  fmt("%.4f deg/100 m", r.kitti.r_err_deg_per_100m) + "   ATE " +
-                  fmt("%.3f m", r.ate.rmse_m) + "   " + std::to_string(r.frames) + " frames",
+              (in.heading.empty() ? std::string() : in.heading + "  |  ") + "t_err " +
+                  fmt("%.3f %%", r.kitti.t_err_pct) + "  |  r_err " +
+                  fmt("%.4f deg/100 m", r.kitti.r_err_deg_per_100m) + "  |  ATE " +
+                  fmt("%.3f m", r.ate.rmse_m) + "  |  " + std::to_string(r.frames) + " frames",
               15, "middle", 0, true);
   draw_top_view(canvas, in);
   draw_length_panel(canvas, 70, r.kitti, /*rotation=*/false);

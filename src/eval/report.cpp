@@ -44,6 +44,10 @@ std::string format_eval_table(const EvalReport& r) {
                 r.frames, r.association.empty() ? "" : ", paired ", r.association.c_str(),
                 r.kitti.path_length_m);
   out += line;
+  if (r.gt_total > r.frames)
+    out += "  note: only " + std::to_string(r.frames) + " of " + std::to_string(r.gt_total) +
+           " ground-truth poses have an estimate; the devkit expects every frame, so its\n"
+           "        10-frame step and the RPE pairs here count paired poses, not frames\n";
   out += "\nKITTI odometry metric (devkit: every 10th first frame, segments of 100..800 m)\n";
   out += "  length [m]  segments  t_err [%]  r_err [deg/100m]\n";
   for (const auto& pl : r.kitti.per_length) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 namespace scfloam::svg {
 namespace {
@@ -97,8 +98,8 @@ double Panel::py(double y) const { return top_ + height_ - (y - y_min_) / (y_max
 
 void Panel::draw_axes(const std::string& title, const std::string& x_label,
                       const std::string& y_label) {
-  const auto xt = nice_ticks(x_min_, x_max_, std::max(3, static_cast<int>(width_ / 90)));
-  const auto yt = nice_ticks(y_min_, y_max_, std::max(3, static_cast<int>(height_ / 50)));
+  const auto xt = nice_ticks(x_min_, x_max_, std::clamp(static_cast<int>(width_ / 90), 3, 9));
+  const auto yt = nice_ticks(y_min_, y_max_, std::clamp(static_cast<int>(height_ / 38), 3, 9));
   const double x_step = xt.size() > 1 ? xt[1] - xt[0] : 1, y_step = yt.size() > 1 ? yt[1] - yt[0] : 1;
   const std::string grid = "stroke=\"#dddddd\" stroke-width=\"1\"";
   for (double x : xt) {
@@ -140,6 +141,7 @@ void Panel::polyline(const std::vector<double>& x, const std::vector<double>& y,
   for (std::size_t i = 0; i < n; ++i) {
     if (!std::isfinite(x[i]) || !std::isfinite(y[i])) { flush(); continue; }  // gap, not a jump
     points += num(px(x[i])) + "," + num(py(y[i])) + " ";
+    drawn_px_.emplace_back(px(x[i]), py(y[i]));
   }
   flush();
 }
@@ -148,12 +150,15 @@ void Panel::markers(const std::vector<double>& x, const std::vector<double>& y, 
                     double radius_px) {
   for (std::size_t i = 0; i < std::min(x.size(), y.size()); ++i) {
     if (!std::isfinite(x[i]) || !std::isfinite(y[i])) continue;
+    drawn_px_.emplace_back(px(x[i]), py(y[i]));
     canvas_.raw("<circle cx=\"" + num(px(x[i])) + "\" cy=\"" + num(py(y[i])) + "\" r=\"" +
                 num(radius_px) + "\" fill=\"" + style.color + "\"" + clip() + "/>");
   }
 }
 
 void Panel::segment(double x0, double y0, double x1, double y1, const Style& style) {
+  for (double a = 0; a <= 1.0; a += 0.125)  // sample the line so the legend avoids it too
+    drawn_px_.emplace_back(px(x0 + a * (x1 - x0)), py(y0 + a * (y1 - y0)));
   canvas_.raw("<line x1=\"" + num(px(x0)) + "\" y1=\"" + num(py(y0)) + "\" x2=\"" + num(px(x1)) +
               "\" y2=\"" + num(py(y1)) + "\" " + stroke(style) + clip() + "/>");
 }
@@ -167,7 +172,20 @@ void Panel::legend(const std::vector<LegendEntry>& entries) {
   std::size_t longest = 0;
   for (const auto& e : entries) longest = std::max(longest, e.label.size());
   const double row = 18, box_w = 44 + 7.0 * static_cast<double>(longest), box_h = row * entries.size() + 8;
-  const double x = left_ + 10, y = top_ + 10;
+  double x = left_ + 10, y = top_ + 10;
+  std::size_t fewest = std::numeric_limits<std::size_t>::max();
+  for (int corner = 0; corner < 4; ++corner) {  // top-left, top-right, bottom-left, bottom-right
+    const double cx = corner % 2 == 0 ? left_ + 10 : left_ + width_ - 10 - box_w;
+    const double cy = corner < 2 ? top_ + 10 : top_ + height_ - 10 - box_h;
+    std::size_t covered = 0;
+    for (const auto& [px_x, px_y] : drawn_px_)
+      if (px_x >= cx - 4 && px_x <= cx + box_w + 4 && px_y >= cy - 4 && px_y <= cy + box_h + 4) ++covered;
+    if (covered < fewest) {
+      fewest = covered;
+      x = cx;
+      y = cy;
+    }
+  }
   canvas_.raw("<rect x=\"" + num(x) + "\" y=\"" + num(y) + "\" width=\"" + num(box_w) +
               "\" height=\"" + num(box_h) + "\" fill=\"white\" fill-opacity=\"0.85\" stroke=\"#999999\"/>");
   for (std::size_t i = 0; i < entries.size(); ++i) {

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace scfloam::svg {
@@ -45,6 +46,7 @@ class Panel {
     Style style;
     bool marker = false;
   };
+  // Drawn in the inside corner that covers the fewest of the points drawn so far.
   void legend(const std::vector<LegendEntry>& entries);
 
   double px(double x) const;
@@ -55,6 +57,7 @@ class Panel {
 
   Canvas& canvas_;
   std::string clip_id_;
+  std::vector<std::pair<double, double>> drawn_px_;  // for placing the legend
   double left_, top_, width_, height_;
   double x_min_ = 0, x_max_ = 1, y_min_ = 0, y_max_ = 1;
 };
