@@ -115,7 +115,7 @@ void Panel::draw_axes(const std::string& title, const std::string& x_label,
   canvas_.raw("<rect x=\"" + num(left_) + "\" y=\"" + num(top_) + "\" width=\"" + num(width_) +
               "\" height=\"" + num(height_) + "\" fill=\"none\" stroke=\"#333333\" stroke-width=\"1\"/>");
   canvas_.text(left_ + width_ / 2, top_ + height_ + 36, x_label, 13);
-  canvas_.text(left_ - 48, top_ + height_ / 2, y_label, 13, "middle", -90);
+  canvas_.text(left_ - 56, top_ + height_ / 2, y_label, 13, "middle", -90);
   canvas_.text(left_ + width_ / 2, top_ - 10, title, 15, "middle", 0, true);
   // Everything drawn after this is clipped to the plotting area.
   clip_id_ = "clip" + std::to_string(static_cast<long>(left_)) + "_" + std::to_string(static_cast<long>(top_));
