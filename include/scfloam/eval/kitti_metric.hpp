@@ -1,7 +1,7 @@
 // The KITTI odometry devkit metric (evaluate_odometry.cpp), in double precision.
-// Inputs are KITTI camera-0 poses (T_cam0_cam0I), or both trajectories in any one common
-// frame convention: the relative motions compared are expressed in the pose's own frame, so
-// mixing lidar-frame and camera-frame poses changes r_err/t_err (see docs/evaluation.md).
+// Inputs are KITTI camera-0 poses (T_cam0_cam0I), or both trajectories in one common body
+// convention: the relative motions compared are expressed in the pose's own frame, so a
+// lidar-frame estimate against camera-frame ground truth is meaningless (docs/evaluation.md).
 #pragma once
 
 #include <array>
