@@ -5,6 +5,7 @@
 
 #include "scfloam/error.hpp"
 #include "scfloam/eval/kitti_metric.hpp"
+#include "scfloam/io/kitti.hpp"
 #include "scfloam/se3.hpp"
 
 namespace scfloam {
@@ -150,6 +151,40 @@ TEST(KittiMetric, MismatchedLengthsThrow) {
     EXPECT_NE(std::string(e.what()).find("10"), std::string::npos);
     EXPECT_NE(std::string(e.what()).find("9"), std::string::npos);
   }
+}
+
+}  // namespace
+}  // namespace scfloam
+
+namespace scfloam {
+namespace {
+
+TEST(KittiMetric, ConvertingBothTrajectoriesToCameraKeepsRotationError) {
+  // E' = Tr E Tr^-1 for both converted: same rotation angle per segment; translation differs
+  // by the lever arm (I - R(E)) t_Tr, and a segment's end may move by a frame because distances
+  // are measured along the camera's path instead of the lidar's. Both effects are tiny.
+  PoseList gt, est;
+  Pose T = Pose::Identity(), U = Pose::Identity();
+  for (int i = 0; i < 600; ++i) {
+    gt.push_back(T);
+    est.push_back(U);
+    Pose step = Pose::Identity();
+    step.linear() = so3_exp(Eigen::Vector3d(0, 0, 0.004 * std::sin(0.01 * i)));  // lidar z up
+    step.translation() = Eigen::Vector3d(1.0, 0, 0);                             // x forward
+    T = T * step;
+    Pose est_step = step;
+    est_step.linear() = so3_exp(Eigen::Vector3d(0.0002, 0, 0.0005)) * step.linear();
+    est_step.translation() *= 1.01;
+    U = U * est_step;
+  }
+  const KittiMetric lidar = kitti_metric(gt, est);
+  const KittiMetric camera =
+      kitti_metric(lidar_to_camera_poses(gt, kitti_default_Tr()), lidar_to_camera_poses(est, kitti_default_Tr()));
+  EXPECT_NEAR(camera.r_err_deg_per_100m, lidar.r_err_deg_per_100m, 0.01 * lidar.r_err_deg_per_100m);
+  EXPECT_NEAR(camera.t_err_pct, lidar.t_err_pct, 0.01 * lidar.t_err_pct);
+  // Mixing conventions is not a small change: lidar estimate against camera ground truth.
+  const KittiMetric mixed = kitti_metric(lidar_to_camera_poses(gt, kitti_default_Tr()), est);
+  EXPECT_GT(mixed.t_err_pct, 100.0);  // forward (z) compared with forward (x): ~141 %
 }
 
 }  // namespace
