@@ -21,7 +21,7 @@ void check_config(const LoopDetectionConfig& c) {
 LoopDetector::LoopDetector(const LoopDetectionConfig& config)
     : config_((check_config(config), config)),
       gate_(DistanceGate::from_config(config)),
-      index_(config.descriptor.num_rings, config.tree_rebuild_every) {}
+      index_(config.descriptor.num_rings, config.tree_rebuild_every, config.tree_rebuild_async) {}
 
 LoopQuery LoopDetector::add_keyframe(std::int64_t frame_index, const Eigen::Isometry3d& T_world_lidar,
                                      const std::vector<Eigen::Vector3f>& points_lidar) {

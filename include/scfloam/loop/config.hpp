@@ -25,6 +25,7 @@ struct LoopDetectionConfig {
   int exclude_recent_keyframes = 50;  // the newest keyframes are never loop candidates
   int num_candidates = 10;            // ring-key nearest neighbours aligned per query
   int tree_rebuild_every = 50;        // k-d tree rebuilt once this many keyframes are unindexed
+  bool tree_rebuild_async = true;     // rebuild on a background thread (results are the same)
   double fine_search_ratio = 0.1;     // fine column-shift search: +- this fraction of sectors
   double score_threshold = 0.2;       // accept a candidate whose column cosine distance is <= this
 
