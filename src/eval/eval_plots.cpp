@@ -149,7 +149,8 @@ std::string eval_plot_svg(const EvalPlotInput& in) {
               (in.heading.empty() ? std::string() : in.heading + "  |  ") + "t_err " +
                   fmt("%.3f %%", r.kitti.t_err_pct) + "  |  r_err " +
                   fmt("%.4f deg/100 m", r.kitti.r_err_deg_per_100m) + "  |  ATE " +
-                  fmt("%.3f m", r.ate.rmse_m) + "  |  " + std::to_string(r.frames) + " frames",
+                  fmt("%.3f m", r.ate.rmse_m) + "  |  " + std::to_string(r.frames) +
+                  (r.gt_total > r.frames ? " of " + std::to_string(r.gt_total) + " frames paired" : " frames"),
               15, "middle", 0, true);
   draw_top_view(canvas, in);
   draw_length_panel(canvas, 70, r.kitti, /*rotation=*/false);
