@@ -1,0 +1,29 @@
+// Rendering one LiDAR sweep from the world: one ray per (column, beam), with range noise,
+// per-beam calibration error, dropouts, reflectance and optional motion distortion.
+#pragma once
+
+#include <cstdint>
+
+#include "scfloam/sim/sensor.hpp"
+#include "scfloam/sim/world.hpp"
+#include "scfloam/types.hpp"
+
+namespace scfloam::sim {
+
+struct SweepPoses {
+  Pose T_world_lidar;  // at the scan timestamp (mid-sweep, lidar facing forward)
+  // Off: every column is cast from T_world_lidar (a motion-compensated scan, as KITTI's).
+  // On: column c is cast from interpolate(start, end, (c + 0.5) / columns) and its points are
+  // reported in that moving frame, uncompensated, as a raw sensor does.
+  bool motion_distortion = false;
+  Pose T_world_lidar_start, T_world_lidar_end;
+};
+
+// Renders one sweep. The sweep starts and ends behind the car (azimuth 180 deg) and turns
+// clockwise seen from above, like a Velodyne; point time_s is the column time relative to the
+// scan timestamp (-period/2 .. +period/2). Points are ordered ring by ring (ring 0 = top beam),
+// each ring in firing order. Deterministic in (seed, frame) whatever the thread count.
+Scan render_scan(const World& world, const SensorModel& sensor, const BeamCalibration& calib,
+                 const SweepPoses& poses, std::uint64_t seed, std::uint64_t frame);
+
+}  // namespace scfloam::sim

@@ -1,0 +1,42 @@
+// A scenario = a world plus the lidar trajectory driven through it, ready to render.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+
+#include "scfloam/sim/city.hpp"
+#include "scfloam/sim/route.hpp"
+#include "scfloam/sim/world.hpp"
+
+namespace scfloam::sim {
+
+struct Scenario {
+  World world;
+  SampledTrajectory trajectory;  // T_world_lidar; frame k is at t = k * frame_period_s
+  std::size_t frames = 0;
+  double frame_period_s = 0.1;
+  double route_length_m = 0;
+  CityStats stats;
+  std::string description;  // one line: what route and world this is
+  Pose frame_pose(std::size_t k) const { return trajectory.at(k * frame_period_s); }
+};
+
+// Grid city with a route that loops: a loop around city blocks back to the start, a
+// same-direction revisit of the first street, then a drive around the neighbouring block
+// the other way that returns along the first loop in the opposite direction; routes long
+// enough (>= ~3000 frames) make the first loop longer than 1 km. Blocks get smaller for
+// short routes so that 1000 frames (~850 m) already hold both kinds of revisit. Longer
+// routes continue with a random drive through the grid (more revisits).
+Scenario make_loops_scenario(std::uint64_t seed, std::size_t frames, double mount_height_m = 1.73);
+
+// A long, gently curving avenue with side streets: odometry without loops.
+Scenario make_straight_scenario(std::uint64_t seed, std::size_t frames, double mount_height_m = 1.73);
+
+// Replays lidar poses T_lidar0_lidarK sampled at 10 Hz (e.g. a KITTI ground truth converted
+// with camera_to_lidar_poses): the street follows the path, side streets branch off it,
+// buildings stand back from it; frames = min(frames, poses) (0 = all).
+Scenario make_replay_scenario(const PoseList& T_lidar0_lidar, std::uint64_t seed,
+                              std::size_t frames, double mount_height_m = 1.73);
+
+}  // namespace scfloam::sim

@@ -1,0 +1,43 @@
+// `scfloam simulate`: a whole KITTI odometry sequence from a scenario.
+//
+//   SimConfig cfg;  cfg.frames = 200;  cfg.route = "loops";
+//   simulate_sequence(cfg, "/tmp/seq", /*progress=*/false);
+//   auto seq = KittiSequence::open("/tmp/seq");   // velodyne/, calib.txt, times.txt, poses.txt
+//
+// In memory (tests): auto sc = build_scenario(cfg); then render_scan(sc.world, ...) per pose.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+
+#include "scfloam/sim/scenario.hpp"
+#include "scfloam/sim/sensor.hpp"
+
+namespace scfloam::sim {
+
+struct SimConfig {
+  std::uint64_t seed = 1;
+  std::size_t frames = 1000;      // replay: 0 = every pose of the file
+  std::string route = "loops";    // "loops", "straight" or "kitti" (replay)
+  std::filesystem::path replay_poses;  // KITTI camera-0 poses file for route "kitti"
+  std::string sensor = "hdl64";   // see sensor_preset_names()
+  bool motion_distortion = false;  // KITTI's own scans are already compensated
+  // Overrides of the preset's noise (negative = keep the preset's value).
+  double range_noise_m = -1;
+  double dropout_prob = -1;
+};
+
+SensorModel sensor_for(const SimConfig& config);
+// World + trajectory for the config (throws scfloam::Error for a bad route or poses file).
+Scenario build_scenario(const SimConfig& config);
+
+// Writes velodyne/NNNNNN.bin, calib.txt (KITTI's Tr), times.txt (10 Hz), poses.txt (camera-0
+// ground truth, first pose identity) and sim.yaml (the parameters used) into out_dir, which
+// is created if needed. Same config -> same bytes.
+void simulate_sequence(const SimConfig& config, const std::filesystem::path& out_dir, bool progress);
+
+// Ground-truth lidar poses relative to the first frame (what poses.txt encodes).
+PoseList relative_lidar_poses(const Scenario& scenario);
+
+}  // namespace scfloam::sim

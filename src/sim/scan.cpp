@@ -1,0 +1,88 @@
+// One sweep: cast every (column, beam) ray in parallel over columns, then emit the returns
+// ring by ring. Every random draw is keyed by (seed, frame, column, beam).
+#include "scfloam/sim/scan.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "scfloam/se3.hpp"
+#include "scfloam/sim/rng.hpp"
+
+namespace scfloam::sim {
+
+Scan render_scan(const World& world, const SensorModel& sensor, const BeamCalibration& calib,
+                 const SweepPoses& poses, std::uint64_t seed, std::uint64_t frame) {
+  const int beams = sensor.beams(), columns = sensor.columns;
+  constexpr double kDeg = M_PI / 180.0;
+  std::vector<double> sin_el(beams), cos_el(beams), sin_el_true(beams), cos_el_true(beams);
+  std::vector<double> cos_az_off(beams), sin_az_off(beams);
+  for (int b = 0; b < beams; ++b) {
+    const double el = sensor.elevations_deg[b] * kDeg;
+    sin_el[b] = std::sin(el);
+    cos_el[b] = std::cos(el);
+    sin_el_true[b] = std::sin(el + calib.elevation_offset_rad[b]);
+    cos_el_true[b] = std::cos(el + calib.elevation_offset_rad[b]);
+    cos_az_off[b] = std::cos(calib.azimuth_offset_rad[b]);
+    sin_az_off[b] = std::sin(calib.azimuth_offset_rad[b]);
+  }
+  std::vector<LidarPoint> slots(static_cast<std::size_t>(beams) * columns);
+  std::vector<std::uint8_t> valid(slots.size(), 0);
+  const std::uint64_t frame_seed = hash_combine(hash_combine(seed, 0x5CA7ULL), frame);
+
+  tbb::parallel_for(tbb::blocked_range<int>(0, columns, 16), [&](const tbb::blocked_range<int>& range) {
+    for (int c = range.begin(); c != range.end(); ++c) {
+      const double frac = (c + 0.5) / columns;
+      // Clockwise from behind the car: azimuth +180 deg -> -180 deg.
+      const double az = M_PI - 2 * M_PI * frac;
+      const Pose T_world_col = poses.motion_distortion
+                                   ? interpolate(poses.T_world_lidar_start, poses.T_world_lidar_end, frac)
+                                   : poses.T_world_lidar;
+      const Eigen::Vector3d origin = T_world_col.translation();
+      const double cos_az = std::cos(az), sin_az = std::sin(az);
+      const float time_s = static_cast<float>((frac - 0.5) * sensor.sweep_period_s);
+      for (int b = 0; b < beams; ++b) {
+        Rng rng(hash_combine(frame_seed, static_cast<std::uint64_t>(c) * 4096 + b));
+        // Direction of the true (miscalibrated) beam: azimuth az + offset.
+        const double cos_true = cos_az * cos_az_off[b] - sin_az * sin_az_off[b];
+        const double sin_true = sin_az * cos_az_off[b] + cos_az * sin_az_off[b];
+        const Eigen::Vector3d dir_true(cos_el_true[b] * cos_true, cos_el_true[b] * sin_true, sin_el_true[b]);
+        const Eigen::Vector3d dir_world = T_world_col.linear() * dir_true;
+        RayHit hit;
+        if (!world.cast(origin, dir_world, sensor.max_range_m, rng.next(), &hit)) continue;
+        const double cos_inc = std::abs(hit.normal.dot(dir_world));
+        // Dropouts: random, more at grazing incidence, and weak returns far away.
+        double p_drop = sensor.dropout_prob;
+        if (cos_inc < 0.1) p_drop += 0.6 * (1 - cos_inc / 0.1);
+        const double far = std::max(1.0, hit.range_m / 30.0);
+        if (hit.reflectance * std::max(cos_inc, 0.05) / (far * far) < 0.002) continue;
+        if (rng.uniform() < p_drop) continue;
+        const double range = hit.range_m + calib.range_bias_m[b] + rng.normal(0, sensor.range_noise_m);
+        if (range < sensor.min_range_m || range > sensor.max_range_m) continue;
+        // The driver reports the point along the nominal beam direction, in the sensor frame
+        // at the firing time: with motion distortion that frame moves during the sweep.
+        const Eigen::Vector3d p = range * Eigen::Vector3d(cos_el[b] * cos_az, cos_el[b] * sin_az, sin_el[b]);
+        const double intensity = hit.reflectance * (0.35 + 0.65 * cos_inc) + rng.normal(0, 0.02);
+        LidarPoint& out = slots[static_cast<std::size_t>(b) * columns + c];
+        out.x = static_cast<float>(p.x());
+        out.y = static_cast<float>(p.y());
+        out.z = static_cast<float>(p.z());
+        out.intensity = static_cast<float>(std::clamp(intensity, 0.0, 0.99));
+        out.time_s = time_s;
+        out.ring = static_cast<std::int16_t>(b);
+        valid[static_cast<std::size_t>(b) * columns + c] = 1;
+      }
+    }
+  });
+
+  Scan scan;
+  scan.has_ring = scan.has_time = true;
+  scan.points.reserve(std::count(valid.begin(), valid.end(), 1));
+  for (std::size_t i = 0; i < slots.size(); ++i)
+    if (valid[i]) scan.points.push_back(slots[i]);
+  return scan;
+}
+
+}  // namespace scfloam::sim
