@@ -27,7 +27,7 @@ struct LoopDetectionConfig {
   int tree_rebuild_every = 50;        // k-d tree rebuilt once this many keyframes are unindexed
   bool tree_rebuild_async = true;     // rebuild on a background thread (results are the same)
   double fine_search_ratio = 0.1;     // fine column-shift search: +- this fraction of sectors
-  double score_threshold = 0.2;       // accept a candidate whose column cosine distance is <= this
+  double score_threshold = 0.3;       // accept a candidate whose column cosine distance is <= this
 
   // Distance gate on current poses: d <= gate_base_m + k / gate_keyframes_per_m (paper eq. 1-3),
   // or d <= fixed_gate_m when adaptive_gate is false (baseline).
