@@ -34,17 +34,28 @@ LoopMatch register_loop_features(const KeyframeView& current,
 
   // The submap lives in the loop keyframe's frame, so the result is T_loop_current directly.
   const Eigen::Isometry3d T_loop_world = submap[loop_index].T_world_lidar.inverse();
-  FeatureMap map(registration, map_config);
+  // Coarse: wider correspondence search (cells hold proportionally more points).
+  RegistrationConfig coarse = registration;
+  coarse.max_neighbor_dist_m = std::max(config.coarse_radius_m, registration.max_neighbor_dist_m);
+  LocalMapConfig coarse_map_config = map_config;
+  const double widening = coarse.max_neighbor_dist_m / registration.max_neighbor_dist_m;
+  coarse_map_config.max_points_per_cell =
+      static_cast<int>(std::ceil(map_config.max_points_per_cell * widening * widening * widening));
+  FeatureMap coarse_map(coarse, coarse_map_config), fine_map(registration, map_config);
   static const FeatureCloud kEmpty;
-  for (const auto& kf : submap)
-    map.insert(kf.edges ? *kf.edges : kEmpty, kf.planes ? *kf.planes : kEmpty,
-               T_loop_world * kf.T_world_lidar);
+  for (const auto& kf : submap) {
+    const Eigen::Isometry3d T_loop_kf = T_loop_world * kf.T_world_lidar;
+    coarse_map.insert(kf.edges ? *kf.edges : kEmpty, kf.planes ? *kf.planes : kEmpty, T_loop_kf);
+    fine_map.insert(kf.edges ? *kf.edges : kEmpty, kf.planes ? *kf.planes : kEmpty, T_loop_kf);
+  }
 
-  ScanToMapRegistration solver(registration);
+  ScanToMapRegistration coarse_solver(coarse), fine_solver(registration);
   for (const Eigen::Isometry3d& guess :
        loop_initial_guesses(submap[loop_index].T_world_lidar, current.T_world_lidar, sc_yaw_rad)) {
-    const RegistrationResult r =
-        solver.align(*current.edges, *current.planes, map, guess, config.rounds);
+    const RegistrationResult rough =
+        coarse_solver.align(*current.edges, *current.planes, coarse_map, guess, config.coarse_rounds);
+    const RegistrationResult r = fine_solver.align(*current.edges, *current.planes, fine_map,
+                                                   rough.T_world_lidar, config.rounds);
     LoopMatch match;
     match.T_loop_current = r.T_world_lidar;
     match.inlier_fraction = static_cast<double>(r.edge_matches + r.plane_matches) / features;

@@ -5,8 +5,12 @@ namespace scfloam {
 
 struct LoopRegistrationConfig {
   int submap_neighbors = 25;  // keyframes each side of the loop keyframe in the submap
-  // Feature registration: correspondence rounds (the loop starts farther off than a frame).
-  int rounds = 10;
+  // Feature registration, coarse to fine: a loop starts farther off than a frame does, so the
+  // first rounds search correspondences within coarse_radius_m, the last ones within the
+  // odometry's own radius.
+  double coarse_radius_m = 2.5;
+  int coarse_rounds = 6;
+  int rounds = 6;
   // A match is accepted when at least this fraction of the current features found a line or
   // plane in the submap and their mean distance is below max_mean_residual_m.
   double min_inlier_fraction = 0.45;
