@@ -1,0 +1,91 @@
+// `scfloam run` end to end through the built binary: outputs, errors, exit codes.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "scfloam/io/trajectory.hpp"
+#include "test_paths.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Outcome {
+  int exit_code = -1;
+  std::string output;  // stdout and stderr
+};
+
+Outcome run_cli(const std::string& args) {
+  const std::string cmd = std::string(SCFLOAM_BINARY_DIR) + "/bin/scfloam " + args + " 2>&1";
+  Outcome out;
+  FILE* pipe = popen(cmd.c_str(), "r");
+  if (!pipe) return out;
+  char buf[4096];
+  while (std::fgets(buf, sizeof buf, pipe)) out.output += buf;
+  const int status = pclose(pipe);
+  out.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return out;
+}
+
+nlohmann::json read_json(const fs::path& path) {
+  std::ifstream in(path);
+  return nlohmann::json::parse(in);
+}
+
+}  // namespace
+
+TEST(CliRun, OdometryOnRealKittiScansWritesEveryOutput) {
+  SCFLOAM_SHARED_DATA_OR_SKIP(seq, "kitti/scans/05");
+  const fs::path out = scfloam::test::scratch_dir("cli_run_real05");
+  const Outcome r = run_cli("run " + seq.string() + " --out " + out.string() + " --mode odometry --quiet");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  for (const char* name : {"poses_kitti.txt", "poses_tum.txt", "odometry_kitti.txt", "summary.json",
+                           "keyframes_kitti.txt", "map.pcd"})
+    EXPECT_TRUE(fs::exists(out / name)) << name;
+  EXPECT_EQ(scfloam::read_kitti_poses(out / "poses_kitti.txt").size(), 10u);
+  EXPECT_EQ(scfloam::read_tum(out / "poses_tum.txt").poses.size(), 10u);
+  const auto summary = read_json(out / "summary.json");
+  EXPECT_EQ(summary["frames"], 10);
+  for (const char* key : {"keyframes", "wall_s", "peak_rss_mb", "timing_ms"})
+    EXPECT_TRUE(summary.contains(key)) << key;
+  for (const char* stage : {"features", "registration"})
+    for (const char* stat : {"median", "mean", "p95", "count"})
+      EXPECT_TRUE(summary["timing_ms"][stage].contains(stat)) << stage << "." << stat;
+  EXPECT_EQ(summary["timing_ms"]["features"]["count"], 10);
+  EXPECT_TRUE(summary.contains("accuracy"));  // poses.txt is there: ATE against it
+  // The car moves about 5 m forward over these frames (ground truth).
+  EXPECT_GT(scfloam::read_kitti_poses(out / "poses_kitti.txt").back().translation().z(), 4.0);
+
+  // A second run into the same folder is refused without --force, and the result survives.
+  const Outcome again = run_cli("run " + seq.string() + " --out " + out.string() + " --mode odometry --quiet");
+  EXPECT_EQ(again.exit_code, 1);
+  EXPECT_NE(again.output.find("--force"), std::string::npos) << again.output;
+  EXPECT_TRUE(fs::exists(out / "summary.json"));
+}
+
+TEST(CliRun, BadInputGivesAClearErrorAndExitCode) {
+  const fs::path dir = scfloam::test::scratch_dir("cli_run_bad");
+  Outcome r = run_cli("run " + (dir / "missing").string() + " --out " + (dir / "o").string());
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.output.find("error: "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("missing"), std::string::npos) << r.output;
+
+  fs::create_directories(dir / "seq" / "velodyne");
+  { std::ofstream bin(dir / "seq" / "velodyne" / "000000.bin", std::ios::binary); bin << "12345"; }
+  { std::ofstream calib(dir / "seq" / "calib.txt"); calib << "Tr: 1 0 0 0 0 1 0 0 0 0 1 0\n"; }
+  r = run_cli("run " + (dir / "seq").string() + " --out " + (dir / "o2").string() + " --quiet");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.output.find("000000.bin"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("multiple of 16"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(dir / "o2" / "summary.json"));
+
+  r = run_cli("run " + (dir / "seq").string() + " --mode nonsense");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.output.find("nonsense"), std::string::npos) << r.output;
+
+  r = run_cli("run");  // missing the required input: a command-line error
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+}
