@@ -65,8 +65,8 @@ struct RegistrationConfig {
 
 // The local feature map around the current pose.
 struct LocalMapConfig {
-  double edge_spacing_m = 0.4;   // a new map point closer than this to a stored one is dropped
-  double plane_spacing_m = 0.8;
+  double edge_spacing_m = 0.2;   // a new map point closer than this to a stored one is dropped
+  double plane_spacing_m = 0.4;
   int max_points_per_cell = 20;  // hash cells are max_neighbor_dist_m wide
   double radius_m = 100.0;       // cells farther than this from the pose are removed
 };

@@ -141,23 +141,48 @@ SlamConfig load_config(const std::filesystem::path& path) {
   return config;
 }
 
+namespace {
+
+// Sections as a tree, in binding order, for emitting nested maps.
+struct SectionTree {
+  std::vector<std::pair<std::string, SectionTree>> children;
+  std::vector<const Binding*> keys;
+
+  SectionTree& child(const std::string& name) {
+    for (auto& c : children)
+      if (c.first == name) return c.second;
+    children.emplace_back(name, SectionTree{});
+    return children.back().second;
+  }
+};
+
+void emit(YAML::Emitter& out, const SectionTree& tree) {
+  out << YAML::BeginMap;
+  for (const Binding* b : tree.keys) {
+    out << YAML::Key << b->key << YAML::Value;
+    std::visit([&](auto* field) { out << *field; }, b->field);
+  }
+  for (const auto& [name, sub] : tree.children) {
+    out << YAML::Key << name << YAML::Value;
+    emit(out, sub);
+  }
+  out << YAML::EndMap;
+}
+
+}  // namespace
+
 std::string config_to_yaml(const SlamConfig& config) {
   SlamConfig copy = config;
-  YAML::Node root;
-  for (auto& b : bindings(copy)) {
-    const auto parts = split_dots(b.section);
-    std::visit(
-        [&](auto* field) {
-          // Walk/create nested maps, then set the key.
-          std::vector<YAML::Node> chain{root};
-          for (const auto& part : parts) chain.push_back(chain.back()[part]);
-          chain.back()[b.key] = *field;
-        },
-        b.field);
+  const auto table = bindings(copy);
+  SectionTree root;
+  for (const auto& b : table) {
+    SectionTree* node = &root;
+    for (const auto& part : split_dots(b.section)) node = &node->child(part);
+    node->keys.push_back(&b);
   }
   YAML::Emitter out;
   out.SetDoublePrecision(17);
-  out << root;
+  emit(out, root);
   return std::string(out.c_str()) + "\n";
 }
 

@@ -74,6 +74,7 @@ OdometryResult Odometry::process(const Scan& scan) {
         s.registration.align(result.edges, result.planes, s.map, T_pred, s.rounds);
     result.T_world_lidar = orthonormalized(reg.T_world_lidar);
     result.degenerate = reg.degenerate;
+    result.registration_rounds = reg.rounds;
     result.edge_matches = reg.edge_matches;
     result.plane_matches = reg.plane_matches;
     result.mean_residual_m = reg.mean_residual_m;

@@ -7,8 +7,8 @@
 namespace scfloam {
 
 VoxelMap::VoxelMap(double max_query_radius_m, double min_spacing_m, int max_points_per_cell)
-    : cell_size_(static_cast<float>(2.0 * max_query_radius_m)),
-      inv_cell_size_(static_cast<float>(1.0 / (2.0 * max_query_radius_m))),
+    : cell_size_(static_cast<float>(max_query_radius_m)),
+      inv_cell_size_(static_cast<float>(1.0 / max_query_radius_m)),
       min_spacing_sq_(static_cast<float>(min_spacing_m * min_spacing_m)),
       max_per_cell_(static_cast<std::uint32_t>(max_points_per_cell)) {
   if (!(max_query_radius_m > 0)) throw Error("voxel map: query radius must be positive");
@@ -50,24 +50,27 @@ void VoxelMap::knn(const Eigen::Vector3f& q, int k, float radius_m, Neighbors& o
   const Eigen::Vector3f s = q * inv_cell_size_;
   const Eigen::Vector3i c(static_cast<int>(std::floor(s.x())), static_cast<int>(std::floor(s.y())),
                           static_cast<int>(std::floor(s.z())));
-  // Cells are 2 * radius wide: the query ball touches q's cell and, per axis, the one
-  // neighbour on the side q is closer to. gap = distance from q to that neighbour's face.
-  Eigen::Vector3i step;
-  Eigen::Vector3f gap;
+  // Squared distance from q to the lower / upper face of its cell, per axis.
+  float lo2[3], hi2[3];
   for (int a = 0; a < 3; ++a) {
-    const float f = s[a] - c[a];
-    step[a] = f < 0.5f ? -1 : 1;
-    gap[a] = (f < 0.5f ? f : 1.f - f) * cell_size_;
+    const float f = (s[a] - c[a]) * cell_size_;
+    lo2[a] = f * f;
+    hi2[a] = (cell_size_ - f) * (cell_size_ - f);
   }
-  const Eigen::Vector3f gap2 = gap.cwiseProduct(gap);
-  // Own cell first, so that the k-th distance shrinks early and prunes the neighbours.
-  for (int m = 0; m < 8; ++m) {
-    const int dx = m & 1, dy = (m >> 1) & 1, dz = (m >> 2) & 1;
-    const float box2 = dx * gap2.x() + dy * gap2.y() + dz * gap2.z();
+  // Cells are `radius` wide, so the ball lies in the 27 around q's cell. Visit q's own cell,
+  // then faces, edges and corners; skip a cell whose box is farther than the current k-th
+  // neighbour (or the radius): most queries read only two or three cells.
+  static constexpr int kOrder[27][3] = {
+      {0, 0, 0},   {-1, 0, 0},  {1, 0, 0},   {0, -1, 0},  {0, 1, 0},   {0, 0, -1}, {0, 0, 1},
+      {-1, -1, 0}, {-1, 1, 0},  {1, -1, 0},  {1, 1, 0},   {-1, 0, -1}, {-1, 0, 1}, {1, 0, -1},
+      {1, 0, 1},   {0, -1, -1}, {0, -1, 1},  {0, 1, -1},  {0, 1, 1},   {-1, -1, -1},
+      {-1, -1, 1}, {-1, 1, -1}, {-1, 1, 1},  {1, -1, -1}, {1, -1, 1},  {1, 1, -1}, {1, 1, 1}};
+  for (const auto& o : kOrder) {
+    float box2 = 0;
+    for (int a = 0; a < 3; ++a) box2 += o[a] < 0 ? lo2[a] : (o[a] > 0 ? hi2[a] : 0.f);
     const float bound = out.count == k ? out.sq_dist[k - 1] : r2;
     if (box2 >= bound) continue;
-    const std::uint32_t cell = index_.find(
-        voxel_key(c.x() + dx * step.x(), c.y() + dy * step.y(), c.z() + dz * step.z()));
+    const std::uint32_t cell = index_.find(voxel_key(c.x() + o[0], c.y() + o[1], c.z() + o[2]));
     if (cell == FlatKeyIndex::kNone) continue;
     const Eigen::Vector3f* pts = cell_points(cell);
     const std::uint32_t n = cells_[cell].count;

@@ -20,6 +20,7 @@ struct OdometryResult {
   double registration_ms = 0;  // prediction + scan-to-map + map update
   bool degenerate = false;     // the solve was poorly constrained in some direction
   // Diagnostics of the scan-to-map solve (zero on the first frame).
+  int registration_rounds = 0;  // correspondence rounds run
   int edge_matches = 0;
   int plane_matches = 0;
   double mean_residual_m = 0;

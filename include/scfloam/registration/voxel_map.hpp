@@ -1,6 +1,7 @@
 // Incremental local map of feature points: hash cells with a bounded number of points each.
 // Replaces F-LOAM's "crop the map and rebuild a k-d tree every frame": inserting a frame and
-// dropping far cells cost O(points touched), and a k-nearest query reads at most 8 cells.
+// dropping far cells cost O(points touched), and a k-nearest query reads the few cells of the
+// 27 around it that can still hold a closer point.
 #pragma once
 
 #include <Eigen/Geometry>
@@ -23,7 +24,7 @@ class VoxelMap {
     int count = 0;  // sorted by distance, nearest first
   };
 
-  // Queries are exact within `max_query_radius_m` (cells are twice that wide). A point is not
+  // Queries are exact within `max_query_radius_m` (the cell width). A point is not
   // stored when one already in its cell lies within `min_spacing_m`, or the cell is full.
   VoxelMap(double max_query_radius_m, double min_spacing_m, int max_points_per_cell);
 
@@ -39,7 +40,7 @@ class VoxelMap {
   void clear();
   std::size_t num_points() const { return num_points_; }
   std::size_t num_cells() const { return cells_.size(); }
-  double max_query_radius_m() const { return 0.5 * cell_size_; }
+  double max_query_radius_m() const { return cell_size_; }
   // Every stored point (for saving maps and debugging; order unspecified).
   FeatureCloud points() const;
 

@@ -1,0 +1,104 @@
+// Odometry speed on real KITTI HDL-64E scans (../shared/data/kitti/scans/NN).
+//   build*/bin/bench_odometry [--benchmark_filter=...]   (SCFLOAM_KITTI_SCANS=dir to override)
+// Features: crop + rings + curvature + selection + voxel filter, one scan.
+// ProcessStep: a full Odometry::process() (features + scan-to-map + map update) per frame over
+// the ten scans, replayed forwards then backwards so the map keeps being extended.
+// Knn: one 5-nearest query of the registration against a map of ten frames.
+#include <benchmark/benchmark.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <map>
+#include <string>
+
+#include "scfloam/features/feature_extractor.hpp"
+#include "scfloam/io/kitti.hpp"
+#include "scfloam/odometry/odometry.hpp"
+#include "scfloam/registration/scan_to_map.hpp"
+#include "scfloam/registration/voxel_filter.hpp"
+
+namespace {
+using namespace scfloam;
+
+std::filesystem::path scans_dir(const char* seq) {
+  if (const char* env = std::getenv("SCFLOAM_KITTI_SCANS")) return env;
+  return std::filesystem::path(SCFLOAM_BENCH_SHARED_DIR) / "data/kitti/scans" / seq;
+}
+
+const std::vector<Scan>& scans(const char* seq) {
+  static std::map<std::string, std::vector<Scan>> cache;
+  auto& v = cache[seq];
+  if (v.empty()) {
+    const auto s = KittiSequence::open(scans_dir(seq));
+    for (std::size_t i = 0; i < s.size(); ++i) v.push_back(s.load(i));
+  }
+  return v;
+}
+
+void BM_Features(benchmark::State& state, const char* seq) {
+  const auto& all = scans(seq);
+  const OdometryConfig c;
+  FeatureExtractor extractor(c.preprocess, c.rings, c.features);
+  VoxelFilter filter;
+  FeatureCloud edges, planes, e2, p2;
+  std::size_t i = 0;
+  for (auto _ : state) {
+    const Scan& scan = all[i++ % all.size()];
+    extractor.extract(scan.points, false, edges, planes);
+    filter.filter(edges, c.features.edge_leaf_m, e2);
+    filter.filter(planes, c.features.plane_leaf_m, p2);
+    benchmark::DoNotOptimize(p2.data());
+  }
+  state.counters["edges"] = static_cast<double>(e2.size());
+  state.counters["planes"] = static_cast<double>(p2.size());
+}
+
+void BM_ProcessStep(benchmark::State& state, const char* seq) {
+  const auto& all = scans(seq);
+  Odometry odometry{OdometryConfig{}};
+  // Warm up past F-LOAM's 12 initial rounds so the timing is the steady state.
+  std::size_t i = 0;
+  auto next = [&]() -> const Scan& {
+    const std::size_t n = all.size(), k = i++ % (2 * n - 2);
+    return all[k < n ? k : 2 * n - 2 - k];  // 0..9, 8..1, 0..9, ...
+  };
+  for (int w = 0; w < 12; ++w) odometry.process(next());
+  double features_ms = 0, registration_ms = 0;
+  for (auto _ : state) {
+    const auto r = odometry.process(next());
+    features_ms += r.features_ms;
+    registration_ms += r.registration_ms;
+  }
+  state.counters["features_ms"] = features_ms / state.iterations();
+  state.counters["registration_ms"] = registration_ms / state.iterations();
+}
+
+void BM_Knn(benchmark::State& state) {
+  const auto& all = scans("05");
+  const OdometryConfig c;
+  FeatureExtractor extractor(c.preprocess, c.rings, c.features);
+  FeatureMap map(c.registration, c.map);
+  Odometry odometry(c);
+  FeatureCloud queries;
+  for (const auto& scan : all) {
+    const auto r = odometry.process(scan);
+    map.insert(r.edges, r.planes, r.T_world_lidar);
+    queries = transform_cloud(r.planes, r.T_world_lidar);
+  }
+  VoxelMap::Neighbors nb;
+  std::size_t i = 0;
+  for (auto _ : state) {
+    map.planes().knn(queries[i++ % queries.size()], 5, 1.0f, nb);
+    benchmark::DoNotOptimize(nb.count);
+  }
+}
+
+BENCHMARK_CAPTURE(BM_Features, kitti05, "05")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Features, kitti08, "08")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_ProcessStep, kitti05, "05")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_ProcessStep, kitti08, "08")->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Knn)->Unit(benchmark::kNanosecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();

@@ -1,0 +1,136 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "scfloam/features/deskew.hpp"
+#include "scfloam/features/feature_extractor.hpp"
+
+namespace scfloam {
+namespace {
+
+TEST(Curvature, ZeroOnALineLargeAtACorner) {
+  std::vector<Eigen::Vector3f> line, corner;
+  for (int i = 0; i < 21; ++i) {
+    line.emplace_back(0.1f * i, 5.f, 0.f);
+    // An L: along x up to the middle, then along y.
+    corner.emplace_back(i <= 10 ? 0.1f * i : 1.f, i <= 10 ? 0.f : 0.1f * (i - 10), 0.f);
+  }
+  std::vector<float> c_line(21), c_corner(21);
+  ring_curvature(line.data(), 21, 5, c_line.data());
+  ring_curvature(corner.data(), 21, 5, c_corner.data());
+  for (int i = 5; i < 16; ++i) EXPECT_NEAR(c_line[i], 0.f, 1e-6f);
+  // At the apex: sum of neighbours - 10 p = (-1.5, 1.5, 0) -> 4.5 m^2.
+  EXPECT_NEAR(c_corner[10], 4.5f, 1e-4f);
+  EXPECT_EQ(c_line[0], 0.f);  // ends without a full window
+}
+
+// A 64-beam scan of a room corner seen from inside: two walls meeting at a vertical edge.
+std::vector<LidarPoint> corner_room_scan() {
+  std::vector<LidarPoint> pts;
+  for (int ring = 0; ring < 64; ++ring) {
+    const double elev = (2.0 - ring * 0.4) * M_PI / 180.0;
+    for (int col = 0; col < 1800; ++col) {
+      const double az = col * 2 * M_PI / 1800;
+      const Eigen::Vector3d dir(std::cos(elev) * std::cos(az), std::cos(elev) * std::sin(az),
+                                std::sin(elev));
+      // Walls x = 10 and y = 10 (first quadrant), far walls at -20 elsewhere.
+      double t = 1e9;
+      if (dir.x() > 1e-9) t = std::min(t, 10.0 / dir.x());
+      if (dir.y() > 1e-9) t = std::min(t, 10.0 / dir.y());
+      if (dir.x() < -1e-9) t = std::min(t, -20.0 / dir.x());
+      if (dir.y() < -1e-9) t = std::min(t, -20.0 / dir.y());
+      const Eigen::Vector3d p = t * dir;
+      LidarPoint lp;
+      lp.x = float(p.x()), lp.y = float(p.y()), lp.z = float(p.z());
+      lp.ring = static_cast<std::int16_t>(ring);
+      pts.push_back(lp);
+    }
+  }
+  return pts;
+}
+
+TEST(FeatureExtractor, CornerSceneEdgesOnTheCornersPlanesOnTheWalls) {
+  OdometryConfig c;
+  c.preprocess.max_range_m = 100;
+  FeatureExtractor extractor(c.preprocess, c.rings, c.features);
+  FeatureCloud edges, planes;
+  extractor.extract(corner_room_scan(), /*use_ring_field=*/true, edges, planes);
+  EXPECT_EQ(extractor.stats().rings_used, 64);
+  ASSERT_FALSE(edges.empty());
+  ASSERT_GT(planes.size(), 50000u);
+  // The room's four vertical corners are at (10,10), (-20,10), (-20,-20), (10,-20): every edge
+  // lies within a few samples of one of them; plane points lie on the walls.
+  const Eigen::Vector2f corners[4] = {{10, 10}, {-20, 10}, {-20, -20}, {10, -20}};
+  for (const auto& e : edges) {
+    float best = 1e9f;
+    for (const auto& k : corners) best = std::min(best, (e.head<2>() - k).norm());
+    EXPECT_LT(best, 0.5f) << e.transpose();
+  }
+  for (std::size_t i = 0; i < planes.size(); i += 97) {
+    const auto& p = planes[i];
+    const float to_wall = std::min({std::abs(p.x() - 10), std::abs(p.y() - 10),
+                                    std::abs(p.x() + 20), std::abs(p.y() + 20)});
+    EXPECT_LT(to_wall, 1e-3f);
+  }
+  // At most 20 edges per sector, 6 sectors, 64 rings.
+  EXPECT_LE(edges.size(), 64u * 6u * 20u);
+}
+
+TEST(FeatureExtractor, RangeCropDropsNearFarAndNonFinitePoints) {
+  OdometryConfig c;
+  FeatureExtractor extractor(c.preprocess, c.rings, c.features);
+  std::vector<LidarPoint> pts = corner_room_scan();
+  pts[0].x = std::nanf("");
+  pts[1].x = 1.0f, pts[1].y = 0.f, pts[1].z = 0.f;  // inside min range 3 m
+  FeatureCloud edges, planes;
+  extractor.extract(pts, true, edges, planes);
+  for (const auto& p : planes) {
+    ASSERT_TRUE(p.allFinite());
+    const float r = p.head<2>().norm();
+    EXPECT_GE(r, 3.f);
+    EXPECT_LE(r, 90.f);
+  }
+  // The far walls beyond 90 m horizontal range cannot appear (corner at 28 m is kept).
+  EXPECT_LT(extractor.stats().kept_points, extractor.stats().input_points);
+}
+
+TEST(FeatureExtractor, RingsFromElevationMatchRingField) {
+  OdometryConfig c;
+  c.rings.lidar = "hdl64";
+  FeatureExtractor a(c.preprocess, c.rings, c.features), b(c.preprocess, c.rings, c.features);
+  std::vector<LidarPoint> pts;
+  for (int ring = 0; ring < 64; ++ring) {
+    // Beam centres nudged 0.05 deg inwards: the table's ends (+2, -24.33) are exclusive.
+    const double elev = (ring <= 32 ? 2.0 - ring / 3.0 : -8.83 - (ring - 32) * 0.5) + (ring == 63 ? 0.05 : -0.05);
+    for (int col = 0; col < 1000; ++col) {
+      const double az = col * 2 * M_PI / 1000, r = 20 + 3 * std::sin(5 * az);
+      LidarPoint p;
+      p.x = float(r * std::cos(elev * M_PI / 180) * std::cos(az));
+      p.y = float(r * std::cos(elev * M_PI / 180) * std::sin(az));
+      p.z = float(r * std::sin(elev * M_PI / 180));
+      p.ring = static_cast<std::int16_t>(ring);
+      pts.push_back(p);
+    }
+  }
+  FeatureCloud e1, p1, e2, p2;
+  a.extract(pts, false, e1, p1);
+  b.extract(pts, true, e2, p2);
+  EXPECT_EQ(e1.size(), e2.size());
+  EXPECT_EQ(p1.size(), p2.size());
+}
+
+TEST(Deskew, ConstantVelocityMovesPointsToTheReferenceTime) {
+  std::vector<LidarPoint> pts(1);
+  pts[0].x = 10, pts[0].y = 0, pts[0].z = 0, pts[0].time_s = 0.05f;
+  // Moving forward at 10 m/s: a point seen 0.05 s later was measured 0.5 m further along.
+  deskew_constant_velocity(pts, Eigen::Vector3d::Zero(), Eigen::Vector3d(10, 0, 0));
+  EXPECT_NEAR(pts[0].x, 10.5f, 1e-5f);
+  // Yawing at 1 rad/s: rotate by 0.05 rad.
+  pts[0].x = 10, pts[0].y = 0;
+  deskew_constant_velocity(pts, Eigen::Vector3d(0, 0, 1), Eigen::Vector3d::Zero());
+  EXPECT_NEAR(pts[0].x, 10 * std::cos(0.05), 1e-4);
+  EXPECT_NEAR(pts[0].y, 10 * std::sin(0.05), 3e-4);  // third-order term |wt|^3 / 6 * range
+}
+
+}  // namespace
+}  // namespace scfloam

@@ -1,0 +1,84 @@
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "scfloam/config.hpp"
+#include "scfloam/error.hpp"
+#include "scfloam/odometry/odometry.hpp"
+#include "test_paths.hpp"
+
+namespace scfloam {
+namespace {
+
+void write(const std::filesystem::path& p, const std::string& text) {
+  std::ofstream(p) << text;
+}
+
+TEST(Config, YamlRoundTripKeepsEveryOdometryValue) {
+  const auto dir = test::scratch_dir("config_round_trip");
+  SlamConfig c;
+  c.odometry.preprocess.min_range_m = 1.25;
+  c.odometry.preprocess.deskew = true;
+  c.odometry.rings.lidar = "vlp16";
+  c.odometry.features.max_edges_per_sector = 7;
+  c.odometry.registration.huber_delta_m = 0.123456789;
+  c.odometry.map.radius_m = 77;
+  save_config(dir / "c.yaml", c);
+  const SlamConfig back = load_config(dir / "c.yaml");
+  EXPECT_EQ(config_to_yaml(back), config_to_yaml(c));
+  EXPECT_DOUBLE_EQ(back.odometry.preprocess.min_range_m, 1.25);
+  EXPECT_TRUE(back.odometry.preprocess.deskew);
+  EXPECT_EQ(back.odometry.rings.lidar, "vlp16");
+  EXPECT_EQ(back.odometry.features.max_edges_per_sector, 7);
+  EXPECT_DOUBLE_EQ(back.odometry.registration.huber_delta_m, 0.123456789);
+  EXPECT_DOUBLE_EQ(back.odometry.map.radius_m, 77);
+}
+
+TEST(Config, PartialFileKeepsDefaults) {
+  const auto dir = test::scratch_dir("config_partial");
+  write(dir / "c.yaml", "odometry:\n  features:\n    edge_leaf_m: 0.3\n");
+  const SlamConfig c = load_config(dir / "c.yaml");
+  EXPECT_DOUBLE_EQ(c.odometry.features.edge_leaf_m, 0.3);
+  EXPECT_DOUBLE_EQ(c.odometry.features.plane_leaf_m, OdometryConfig{}.features.plane_leaf_m);
+}
+
+void expect_error_naming(const std::filesystem::path& p, const std::string& needle) {
+  try {
+    load_config(p);
+    ADD_FAILURE() << "no error for " << p;
+  } catch (const Error& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find(p.string()), std::string::npos) << msg;
+    EXPECT_NE(msg.find(needle), std::string::npos) << msg;
+  }
+}
+
+TEST(Config, UnknownKeysAndWrongTypesAreErrorsNamingFileAndKey) {
+  const auto dir = test::scratch_dir("config_errors");
+  write(dir / "typo.yaml", "odometry:\n  features:\n    edge_leaf: 0.3\n");
+  expect_error_naming(dir / "typo.yaml", "odometry.features.edge_leaf");
+  write(dir / "section.yaml", "odometri:\n  features: {}\n");
+  expect_error_naming(dir / "section.yaml", "odometri");
+  write(dir / "type.yaml", "odometry:\n  registration:\n    knn: five\n");
+  expect_error_naming(dir / "type.yaml", "odometry.registration.knn");
+  write(dir / "bool.yaml", "odometry:\n  preprocess:\n    deskew: 3\n");
+  expect_error_naming(dir / "bool.yaml", "odometry.preprocess.deskew");
+  expect_error_naming(dir / "missing.yaml", "cannot open");
+}
+
+TEST(Config, ShippedPresetsLoadAndConstructTheOdometry) {
+  // tests/odometry/this_file.cpp -> repository root.
+  const std::filesystem::path config_dir =
+      std::filesystem::path(__FILE__).parent_path().parent_path().parent_path() / "config";
+  int n = 0;
+  for (const char* name : {"kitti-hdl64.yaml", "vlp16.yaml", "hdl32.yaml", "os1-64.yaml", "os1-128.yaml"}) {
+    SCOPED_TRACE(name);
+    const SlamConfig c = load_config(config_dir / name);
+    EXPECT_NO_THROW(Odometry{c.odometry});
+    ++n;
+  }
+  EXPECT_EQ(n, 5);
+}
+
+}  // namespace
+}  // namespace scfloam

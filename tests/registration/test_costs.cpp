@@ -1,0 +1,119 @@
+// Analytic Jacobians of the residuals against numerical differentiation through the manifold.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "scfloam/registration/feature_costs.hpp"
+#include "scfloam/registration/pose_manifold.hpp"
+#include "scfloam/se3.hpp"
+
+namespace scfloam {
+namespace {
+
+Eigen::Isometry3d some_pose() {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = so3_exp(Eigen::Vector3d(0.1, -0.2, 0.7));
+  T.translation() = Eigen::Vector3d(120.0, -35.0, 4.0);  // far from the origin on purpose
+  return T;
+}
+
+// d r / d delta by central differences of r(Plus(x, delta)).
+template <typename F>
+Eigen::MatrixXd numeric_jacobian(const F& residual, const Eigen::Isometry3d& T, int rows) {
+  PoseManifold manifold;
+  double x[7], xp[7], xm[7];
+  pose_to_block(T, x);
+  Eigen::MatrixXd J(rows, 6);
+  const double h = 1e-6;
+  for (int k = 0; k < 6; ++k) {
+    double d[6] = {0, 0, 0, 0, 0, 0};
+    d[k] = h;
+    manifold.Plus(x, d, xp);
+    d[k] = -h;
+    manifold.Plus(x, d, xm);
+    J.col(k) = (residual(block_to_pose(xp)) - residual(block_to_pose(xm))) / (2 * h);
+  }
+  return J;
+}
+
+TEST(FeatureCosts, EdgeResidualIsPointToLineDistanceAndJacobianMatchesNumeric) {
+  const Eigen::Isometry3d T = some_pose();
+  EdgeMatch m{{3.0, -1.0, 0.5}, T * Eigen::Vector3d(3.5, -1.2, 0.1), Eigen::Vector3d(0.2, 0.9, 0.4).normalized()};
+  Jacobian36 J;
+  const Eigen::Vector3d r = edge_residual(m, T.linear(), T.translation(), &J);
+  const Eigen::Vector3d d = T * m.point_lidar - m.line_point;
+  EXPECT_NEAR(r.norm(), d.cross(m.line_dir).norm(), 1e-9);
+  EXPECT_NEAR(r.dot(m.line_dir), 0.0, 1e-9);
+  const auto f = [&](const Eigen::Isometry3d& X) -> Eigen::VectorXd {
+    return edge_residual(m, X.linear(), X.translation(), nullptr);
+  };
+  EXPECT_LT((numeric_jacobian(f, T, 3) - Eigen::MatrixXd(J)).norm(), 1e-6);
+}
+
+TEST(FeatureCosts, PlaneResidualAndJacobianMatchNumeric) {
+  const Eigen::Isometry3d T = some_pose();
+  const Eigen::Vector3d n = Eigen::Vector3d(0.3, -0.4, 0.87).normalized();
+  PlaneMatch m{{-4.0, 2.0, 1.0}, n, -n.dot(T * Eigen::Vector3d(-4.2, 2.1, 0.8))};
+  Jacobian16 J;
+  const double r = plane_residual(m, T.linear(), T.translation(), &J);
+  EXPECT_NEAR(r, n.dot(T * m.point_lidar) + m.offset, 1e-12);
+  const auto f = [&](const Eigen::Isometry3d& X) -> Eigen::VectorXd {
+    return Eigen::VectorXd::Constant(1, plane_residual(m, X.linear(), X.translation(), nullptr));
+  };
+  EXPECT_LT((numeric_jacobian(f, T, 1) - Eigen::MatrixXd(J)).norm(), 1e-6);
+}
+
+TEST(FeatureCosts, HuberFoldedResidualSquaresToRhoAndJacobianMatchesNumeric) {
+  const double delta = 0.1;
+  const Eigen::Isometry3d T = some_pose();
+  // An outlier edge (residual 0.6 m >> delta) and an inlier.
+  for (double offset : {0.6, 0.03}) {
+    EdgeMatch m{{3.0, -1.0, 0.5}, T * Eigen::Vector3d(3.0, -1.0 + offset, 0.5), Eigen::Vector3d::UnitZ()};
+    Jacobian36 J;
+    Eigen::Vector3d r = edge_residual(m, T.linear(), T.translation(), &J);
+    const double s = r.squaredNorm();
+    robustify_huber<3>(delta, r, &J);
+    const double rho = s <= delta * delta ? s : 2 * delta * std::sqrt(s) - delta * delta;
+    EXPECT_NEAR(r.squaredNorm(), rho, 1e-12);
+    const auto f = [&](const Eigen::Isometry3d& X) -> Eigen::VectorXd {
+      Eigen::Vector3d v = edge_residual(m, X.linear(), X.translation(), nullptr);
+      robustify_huber<3>(delta, v, nullptr);
+      return v;
+    };
+    EXPECT_LT((numeric_jacobian(f, T, 3) - Eigen::MatrixXd(J)).norm(), 1e-6) << offset;
+  }
+}
+
+TEST(FeatureCosts, CeresCostEvaluatesEveryMatchWithTangentJacobian) {
+  const Eigen::Isometry3d T = some_pose();
+  std::vector<EdgeMatch> edges{{{1, 2, 3}, {100, -30, 5}, Eigen::Vector3d::UnitX()}};
+  std::vector<PlaneMatch> planes{{{-1, 0, 2}, Eigen::Vector3d::UnitZ(), -3.0}};
+  FeatureCost cost(edges, planes, 0.1);
+  ASSERT_EQ(cost.num_residuals(), 4);
+  double x[7];
+  pose_to_block(T, x);
+  const double* params[] = {x};
+  double residuals[4], jac[4 * 7];
+  double* jacs[] = {jac};
+  ASSERT_TRUE(cost.Evaluate(params, residuals, jacs));
+  Jacobian16 Jp;
+  Eigen::Matrix<double, 1, 1> rp(plane_residual(planes[0], T.linear(), T.translation(), &Jp));
+  robustify_huber<1>(0.1, rp, &Jp);
+  EXPECT_NEAR(residuals[3], rp[0], 1e-12);
+  for (int k = 0; k < 6; ++k) EXPECT_NEAR(jac[3 * 7 + k], Jp[k], 1e-12);
+  EXPECT_EQ(jac[3 * 7 + 6], 0.0);
+}
+
+TEST(PoseManifold, PlusMinusRoundTripAndStaysOnSO3) {
+  PoseManifold m;
+  double x[7], y[7], back[6];
+  pose_to_block(some_pose(), x);
+  const double d[6] = {0.3, -0.1, 0.2, 1.0, -2.0, 0.5};
+  m.Plus(x, d, y);
+  EXPECT_NEAR(Eigen::Map<Eigen::Quaterniond>(y).norm(), 1.0, 1e-15);
+  m.Minus(y, x, back);
+  for (int k = 0; k < 6; ++k) EXPECT_NEAR(back[k], d[k], 1e-12);
+}
+
+}  // namespace
+}  // namespace scfloam

@@ -1,0 +1,81 @@
+// Registration of a real KITTI scan against its own map from a known offset.
+#include <gtest/gtest.h>
+
+#include "scfloam/features/feature_extractor.hpp"
+#include "scfloam/io/kitti.hpp"
+#include "scfloam/registration/scan_to_map.hpp"
+#include "scfloam/registration/voxel_filter.hpp"
+#include "scfloam/se3.hpp"
+#include "test_paths.hpp"
+
+namespace scfloam {
+namespace {
+
+struct Features {
+  FeatureCloud edges, planes;
+};
+
+Features features_of(const Scan& scan, const OdometryConfig& c) {
+  FeatureExtractor extractor(c.preprocess, c.rings, c.features);
+  FeatureCloud e, p;
+  extractor.extract(scan.points, false, e, p);
+  return {voxel_downsample(e, c.features.edge_leaf_m), voxel_downsample(p, c.features.plane_leaf_m)};
+}
+
+TEST(ScanToMap, RecoversAKnownMotionOfKitti05Frame0) {
+  SCFLOAM_SHARED_DATA_OR_SKIP(dir, "kitti/scans/05");
+  const auto seq = KittiSequence::open(dir);
+  const OdometryConfig c;
+  // Map: frame 0's full-density features (the map side of a match is dense in practice).
+  FeatureExtractor extractor(c.preprocess, c.rings, c.features);
+  FeatureCloud map_e, map_p;
+  extractor.extract(seq.load(0).points, false, map_e, map_p);
+  FeatureMap map(c.registration, c.map);
+  map.insert(map_e, map_p, Eigen::Isometry3d::Identity());
+  // Query: the same scan's downsampled features, registered from a start 0.3 m and 1 deg off.
+  const Features f = features_of(seq.load(0), c);
+  Eigen::Matrix<double, 6, 1> xi;
+  xi << 0.0, 0.0, 1.0 * M_PI / 180, 0.3, -0.1, 0.05;
+  const Eigen::Isometry3d T_init = left_perturb(xi, Eigen::Isometry3d::Identity());
+  const RegistrationResult r = register_features(f.edges, f.planes, map, T_init, c.registration, 12);
+  EXPECT_LT(r.T_world_lidar.translation().norm(), 0.01);
+  EXPECT_LT(rotation_angle_rad(r.T_world_lidar.linear()) * 180 / M_PI, 0.02);
+  EXPECT_GT(r.plane_matches, 1000);
+  EXPECT_GT(r.edge_matches, 300);
+  EXPECT_FALSE(r.degenerate);
+}
+
+TEST(ScanToMap, Kitti05FramePairMatchesGroundTruth) {
+  SCFLOAM_SHARED_DATA_OR_SKIP(dir, "kitti/scans/05");
+  const auto seq = KittiSequence::open(dir);
+  const PoseList gt = seq.ground_truth_lidar();
+  const OdometryConfig c;
+  FeatureExtractor extractor(c.preprocess, c.rings, c.features);
+  FeatureCloud map_e, map_p;
+  extractor.extract(seq.load(4).points, false, map_e, map_p);
+  FeatureMap map(c.registration, c.map);
+  map.insert(map_e, map_p, gt[4]);
+  const Features f = features_of(seq.load(5), c);
+  const RegistrationResult r = register_features(f.edges, f.planes, map, gt[4], c.registration, 12);
+  const Eigen::Isometry3d err = gt[5].inverse() * r.T_world_lidar;
+  EXPECT_LT(err.translation().norm(), 0.05);
+  EXPECT_LT(rotation_angle_rad(err.linear()) * 180 / M_PI, 0.1);
+}
+
+TEST(ScanToMap, FlatGroundOnlyIsDegenerate) {
+  // A single plane constrains one translation direction: the solve must say so.
+  FeatureCloud ground;
+  for (int i = -20; i <= 20; ++i)
+    for (int j = -20; j <= 20; ++j) ground.emplace_back(0.3f * i, 0.3f * j, -1.7f);
+  const OdometryConfig c;
+  FeatureMap map(c.registration, c.map);
+  map.insert({}, ground, Eigen::Isometry3d::Identity());
+  const RegistrationResult r =
+      register_features({}, ground, map, Eigen::Isometry3d::Identity(), c.registration, 2);
+  EXPECT_GT(r.plane_matches, 100);
+  EXPECT_TRUE(r.degenerate);
+  EXPECT_LT(std::abs(r.weakest_translation_dir.z()), 1e-6);
+}
+
+}  // namespace
+}  // namespace scfloam
