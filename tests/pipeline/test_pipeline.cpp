@@ -1,0 +1,93 @@
+// The whole system on a simulated drive with loops: deterministic mode repeats itself exactly,
+// accepted loops are true revisits, and closing them makes the trajectory better than the
+// odometry's.
+#include <gtest/gtest.h>
+
+#include "scfloam/eval/report.hpp"
+#include "scfloam/io/kitti.hpp"
+#include "scfloam/io/scan_source.hpp"
+#include "scfloam/pipeline/pipeline.hpp"
+#include "scfloam/sim/simulate.hpp"
+#include "test_paths.hpp"
+
+using namespace scfloam;
+namespace fs = std::filesystem;
+
+namespace {
+
+// A 600-frame (~400 m) city drive with same- and opposite-direction revisits, simulated once
+// per build tree (tests run as separate processes; the folder appears complete or not at all).
+fs::path loops_sequence() {
+  const fs::path dir = fs::path(SCFLOAM_BINARY_DIR) / "test-scratch" / "pipeline_loops_seed5_600";
+  if (fs::exists(dir / "poses.txt")) return dir;
+  const fs::path tmp = dir.string() + ".tmp-" + std::to_string(::getpid());
+  fs::remove_all(tmp);
+  sim::SimConfig config;
+  config.seed = 5;
+  config.frames = 600;
+  config.route = "loops";
+  sim::simulate_sequence(config, tmp, false);
+  std::error_code ec;
+  fs::rename(tmp, dir, ec);  // another process may have won the race: use its copy
+  if (ec) fs::remove_all(tmp);
+  return dir;
+}
+
+RunResult run(const ScanSource& source, SlamMode mode) {
+  RunOptions options;
+  options.mode = mode;
+  options.progress = false;
+  options.deterministic = true;
+  return run_slam(source, SlamConfig{}, options);
+}
+
+EvalReport accuracy(const ScanSource& source, const PoseList& est) {
+  const auto Tr = *source.T_cam0_lidar();
+  return evaluate_trajectory(lidar_to_camera_poses(source.ground_truth_lidar(), Tr),
+                             lidar_to_camera_poses(est, Tr));
+}
+
+}  // namespace
+
+TEST(Pipeline, OptimizedModeClosesTrueLoopsAndIsDeterministic) {
+  const auto source = open_scan_source(loops_sequence());
+  const PoseList gt = source->ground_truth_lidar();
+  const RunResult first = run(*source, SlamMode::kOptimized);
+  const RunResult second = run(*source, SlamMode::kOptimized);
+
+  ASSERT_EQ(first.T_world_lidar.size(), source->size());
+  ASSERT_EQ(second.T_world_lidar.size(), source->size());
+  for (std::size_t i = 0; i < first.T_world_lidar.size(); ++i)
+    ASSERT_TRUE(first.T_world_lidar[i].matrix() == second.T_world_lidar[i].matrix()) << "frame " << i;
+
+  // Every accepted loop joins frames that are truly close (no false loop), and there are some.
+  std::size_t accepted = 0;
+  for (const auto& row : first.loop_rows) {
+    if (row.verdict != LoopVerdict::kAccepted) continue;
+    ++accepted;
+    const double d = (gt[row.current_frame].translation() - gt[row.loop_frame].translation()).norm();
+    EXPECT_LT(d, 10.0) << "accepted loop " << row.current_frame << " -> " << row.loop_frame;
+  }
+  EXPECT_GE(accepted, 5u);
+
+  // Closing loops improves on the odometry it started from.
+  const EvalReport odometry = accuracy(*source, first.odometry_T_world_lidar);
+  const EvalReport optimized = accuracy(*source, first.T_world_lidar);
+  EXPECT_LT(optimized.ate.rmse_m, odometry.ate.rmse_m);
+  EXPECT_LE(optimized.kitti.t_err_pct, odometry.kitti.t_err_pct);
+  std::printf("odometry t_err %.3f %% ATE %.3f m; optimized t_err %.3f %% ATE %.3f m; %zu loops\n",
+              odometry.kitti.t_err_pct, odometry.ate.rmse_m, optimized.kitti.t_err_pct,
+              optimized.ate.rmse_m, accepted);
+}
+
+TEST(Pipeline, OdometryModeMatchesTheOptimizedModesOdometry) {
+  const auto source = open_scan_source(loops_sequence());
+  const RunResult odometry = run(*source, SlamMode::kOdometry);
+  EXPECT_TRUE(odometry.loop_rows.empty());
+  EXPECT_EQ(odometry.T_world_lidar.size(), source->size());
+  // Without loops the output is the odometry itself.
+  for (std::size_t i = 0; i < odometry.T_world_lidar.size(); i += 50)
+    EXPECT_TRUE(odometry.T_world_lidar[i].isApprox(odometry.odometry_T_world_lidar[i], 1e-9));
+  const EvalReport report = accuracy(*source, odometry.T_world_lidar);
+  EXPECT_LT(report.kitti.t_err_pct, 2.0);  // sanity bound; the odometry's own bounds are in tests/odometry
+}
