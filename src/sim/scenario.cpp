@@ -218,10 +218,14 @@ Scenario make_replay_scenario(const PoseList& T_lidar0_lidar, std::uint64_t seed
   sc.world = build_city(streets, fit_terrain(bounds, ground), seed, &sc.stats);
   sc.trajectory.dt_s = 0.1;
   sc.trajectory.T_world_lidar = T_lidar0_lidar;
+  // x, y and the rotation are the file's; the height rides on the (single-valued) terrain,
+  // since ground truths drift vertically between passes and the world cannot follow both.
+  for (auto& T : sc.trajectory.T_world_lidar)
+    T.translation().z() = sc.world.terrain_m.sample(T.translation().x(), T.translation().y()) + mount_height_m;
   sc.frames = used;
   sc.route_length_m = 0;
   for (std::size_t k = 1; k < used; ++k)
-    sc.route_length_m += (T_lidar0_lidar[k].translation() - T_lidar0_lidar[k - 1].translation()).norm();
+    sc.route_length_m += (sc.frame_pose(k).translation() - sc.frame_pose(k - 1).translation()).norm();
   sc.description = "replay: " + std::to_string(T_lidar0_lidar.size()) + " poses, street along the path";
   return sc;
 }

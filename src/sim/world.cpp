@@ -156,15 +156,35 @@ void World::build_index(double cell_m) {
   for (std::uint32_t i = 0; i < primitives.size(); ++i)
     for_cells(primitives[i], [&](std::size_t c) { cell_items_[fill[c]++] = i; });
 
-  // Steepest slope of the terrain: bounds how fast a ray can approach the ground.
-  max_terrain_slope_ = 0.01;
-  for (int iy = 0; iy + 1 < terrain_m.ny; ++iy)
-    for (int ix = 0; ix + 1 < terrain_m.nx; ++ix) {
-      const double sx = std::abs(terrain_m.at(ix + 1, iy) - terrain_m.at(ix, iy));
-      const double sy = std::abs(terrain_m.at(ix, iy + 1) - terrain_m.at(ix, iy));
-      max_terrain_slope_ = std::max(max_terrain_slope_, std::hypot(sx, sy) / terrain_m.cell_m);
+  // Local slope bounds: max slope per 32 m block, dilated to the 3x3 neighbourhood.
+  const Raster2D& T = terrain_m;
+  const int bx = static_cast<int>(std::ceil((T.nx - 1) * T.cell_m / kSlopeBlock)) + 1;
+  const int by = static_cast<int>(std::ceil((T.ny - 1) * T.cell_m / kSlopeBlock)) + 1;
+  Raster2D block_max;
+  block_max.reset(T.x0, T.y0, kSlopeBlock, bx, by, 0.0f);
+  for (int iy = 0; iy + 1 < T.ny; ++iy)
+    for (int ix = 0; ix + 1 < T.nx; ++ix) {
+      const double sx = std::abs(T.at(ix + 1, iy) - T.at(ix, iy)), sy = std::abs(T.at(ix, iy + 1) - T.at(ix, iy));
+      const float slope = static_cast<float>(std::sqrt(sx * sx + sy * sy) / T.cell_m);
+      // A terrain cell can touch two blocks: credit both corners' blocks.
+      for (int cy = iy; cy <= iy + 1; ++cy)
+        for (int cx = ix; cx <= ix + 1; ++cx) {
+          float& b = block_max.at(std::min(bx - 1, static_cast<int>(cx * T.cell_m / kSlopeBlock)),
+                                  std::min(by - 1, static_cast<int>(cy * T.cell_m / kSlopeBlock)));
+          b = std::max(b, slope);
+        }
     }
-  max_terrain_slope_ *= 1.2;
+  slope_bound_ = block_max;
+  for (int iy = 0; iy < by; ++iy)
+    for (int ix = 0; ix < bx; ++ix) {
+      float m = 0;
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int jx = std::clamp(ix + dx, 0, bx - 1), jy = std::clamp(iy + dy, 0, by - 1);
+          m = std::max(m, block_max.at(jx, jy));
+        }
+      slope_bound_.at(ix, iy) = 1.2f * m + 0.01f;
+    }
 }
 
 double World::ground_height(double x, double y) const {
@@ -180,15 +200,22 @@ bool World::cast_ground(const Eigen::Vector3d& o, const Eigen::Vector3d& d, doub
     return o.z() + t * d.z() - terrain_m.sample(x, y) - (*raised ? curb_height_m : 0.0);
   };
   const double horizontal = std::sqrt(d.x() * d.x() + d.y() * d.y());
-  // Per unit of t the gap can shrink at most this fast, plus one curb step when over a road.
-  const double closing = std::max(1e-6, -d.z() + max_terrain_slope_ * horizontal);
+  // A step may reach at most one slope block away (the bound covers the 3x3 blocks).
+  const double max_step = horizontal > 1e-9 ? kSlopeBlock / horizontal : 1e9;
   constexpr double kMinStep = 0.8;  // sidewalks are wider than this: no curb is stepped over
   bool raised = false;
   double t = 0, g = gap(0, &raised);
   if (g <= 0) return false;
   while (t < t_max) {
+    // Per unit of t the gap can shrink at most this fast, plus one curb step over a road.
+    const double x = o.x() + t * d.x(), y = o.y() + t * d.y();
+    const double slope = slope_bound_.values[std::min<std::size_t>(
+        slope_bound_.values.size() - 1,
+        static_cast<std::size_t>(std::clamp(static_cast<int>((y - slope_bound_.y0) / kSlopeBlock), 0, slope_bound_.ny - 1)) * slope_bound_.nx +
+            std::clamp(static_cast<int>((x - slope_bound_.x0) / kSlopeBlock), 0, slope_bound_.nx - 1))];
+    const double closing = std::max(1e-6, -d.z() + slope * horizontal);
     const double reserve = raised ? 0.0 : curb_height_m + 0.01;
-    const double step = std::max(kMinStep, (g - reserve) / closing);
+    const double step = std::clamp((g - reserve) / closing, kMinStep, std::max(kMinStep, max_step));
     const double t_next = std::min(t + step, t_max);
     bool raised_next;
     const double g_next = gap(t_next, &raised_next);

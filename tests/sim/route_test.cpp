@@ -106,14 +106,18 @@ TEST(ReplayRoute, FollowsKittiPosesWithAClearRoad) {
   const Scenario sc = make_replay_scenario(lidar, 4, 300);
   ASSERT_EQ(sc.frames, 300u);
   for (std::size_t k = 0; k < sc.frames; ++k) {
-    EXPECT_LT((sc.frame_pose(k).translation() - lidar[k].translation()).norm(), 1e-9) << k;
+    // x, y and rotation are the file's; z rides 1.73 m over the fitted terrain.
+    EXPECT_LT((sc.frame_pose(k).translation() - lidar[k].translation()).head<2>().norm(), 1e-9) << k;
+    const Eigen::Vector3d c = sc.frame_pose(k).translation();
+    EXPECT_NEAR(c.z() - sc.world.terrain_m.sample(c.x(), c.y()), 1.73, 1e-6) << k;
+    EXPECT_NEAR(c.z(), lidar[k].translation().z(), 1.0) << k;  // 05 is consistent to ~0.6 m
     EXPECT_LT((sc.frame_pose(k).linear() - lidar[k].linear()).norm(), 1e-6) << k;  // KITTI's R is orthonormal to ~1e-7
   }
   // The whole path (not only the replayed frames) runs on the road, clear of every object
   // the car's body could touch (a 2 x 1 m footprint, 0.3-2.0 m above the ground).
   std::size_t checked = 0;
   for (std::size_t k = 0; k < lidar.size(); k += 25, ++checked) {
-    const Eigen::Vector3d c = lidar[k].translation();
+    const Eigen::Vector3d c = sc.trajectory.T_world_lidar[k].translation();
     ASSERT_TRUE(sc.world.on_road(c.x(), c.y())) << k;
     const double g = sc.world.ground_height(c.x(), c.y());
     for (const auto& p : sc.world.primitives)

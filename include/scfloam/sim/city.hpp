@@ -29,16 +29,18 @@ WorldBounds bounds_of(const std::vector<Street>& streets, double margin_m);
 
 // Gentle rolling terrain: a few long-wavelength waves, steepest slope about max_slope.
 Raster2D make_rolling_terrain(const WorldBounds& bounds, std::uint64_t seed, double max_slope);
-// Terrain through given ground points (x, y, z) (a replayed path): smooth, and flat far away.
-Raster2D fit_terrain(const WorldBounds& bounds, const std::vector<Eigen::Vector3d>& ground_points);
+// Terrain through given ground points (x, y, z) (a replayed path): smooth, flat far away,
+// and nowhere steeper than max_slope (conflicting heights of two passes are relaxed).
+Raster2D fit_terrain(const WorldBounds& bounds, const std::vector<Eigen::Vector3d>& ground_points,
+                     double max_slope = 0.12);
 
 struct CityStats {
   std::size_t buildings = 0, trees = 0, poles = 0, cars = 0, signs = 0, fences = 0;
 };
 
 // Rasterizes the streets (curbs), then places the objects from `seed`. The terrain raster
-// must cover the bounds. Objects never stand on a street's roadway except parked cars,
-// which keep at least `clear_lane_m` from every centerline.
+// must cover the bounds. Objects never stand on a roadway except parked cars, which stay
+// next to the curb, at least ~3.9 m from every centerline.
 World build_city(const std::vector<Street>& streets, Raster2D terrain, std::uint64_t seed,
                  CityStats* stats = nullptr);
 

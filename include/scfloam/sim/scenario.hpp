@@ -35,7 +35,9 @@ Scenario make_straight_scenario(std::uint64_t seed, std::size_t frames, double m
 
 // Replays lidar poses T_lidar0_lidarK sampled at 10 Hz (e.g. a KITTI ground truth converted
 // with camera_to_lidar_poses): the street follows the path, side streets branch off it,
-// buildings stand back from it; frames = min(frames, poses) (0 = all).
+// buildings stand back from it; frames = min(frames, poses) (0 = all). x, y and rotation
+// are replayed exactly; z is the terrain (fitted to the file's heights) + mount height,
+// because real ground truths drift vertically between passes of the same street.
 Scenario make_replay_scenario(const PoseList& T_lidar0_lidar, std::uint64_t seed,
                               std::size_t frames, double mount_height_m = 1.73);
 

@@ -99,7 +99,10 @@ class World {
   double grid_x0_ = 0, grid_y0_ = 0, grid_cell_m_ = 4;
   int grid_nx_ = 0, grid_ny_ = 0;
   double max_object_z_ = 0;
-  double max_terrain_slope_ = 0.1;
+  // Steepest terrain slope within one block of each 32 m block (3x3 dilated): bounds how
+  // fast a ray can approach the ground locally, so gentle areas take long march steps.
+  Raster2D slope_bound_;
+  static constexpr double kSlopeBlock = 32.0;
   std::vector<std::uint32_t> cell_start_, cell_items_;  // CSR: items of cell c
 };
 
