@@ -23,28 +23,44 @@ LoopDetector::LoopDetector(const LoopDetectionConfig& config)
       gate_(DistanceGate::from_config(config)),
       index_(config.descriptor.num_rings, config.tree_rebuild_every, config.tree_rebuild_async) {}
 
+template <class... Clouds>
+LoopQuery LoopDetector::add_clouds(std::int64_t frame_index, const Eigen::Isometry3d& T_world_lidar,
+                                   const Clouds&... clouds) {
+  ScanContextBuilder builder(config_.descriptor);
+  (builder.add(clouds), ...);
+  std::vector<ScanContext> variants;
+  if (config_.lateral_augmentation_m > 0.0)
+    for (const double offset_m : {config_.lateral_augmentation_m, -config_.lateral_augmentation_m}) {
+      ScanContextBuilder shifted(config_.descriptor, static_cast<float>(offset_m));
+      (shifted.add(clouds), ...);
+      variants.push_back(shifted.finish());
+    }
+  return add_keyframe(frame_index, T_world_lidar, builder.finish(), variants);
+}
+
 LoopQuery LoopDetector::add_keyframe(std::int64_t frame_index, const Eigen::Isometry3d& T_world_lidar,
                                      const std::vector<Eigen::Vector3f>& points_lidar) {
-  return add_keyframe(frame_index, T_world_lidar, make_scan_context(points_lidar, config_.descriptor));
+  return add_clouds(frame_index, T_world_lidar, points_lidar);
 }
 
 LoopQuery LoopDetector::add_keyframe(std::int64_t frame_index, const Eigen::Isometry3d& T_world_lidar,
                                      const std::vector<Eigen::Vector3f>& edges_lidar,
                                      const std::vector<Eigen::Vector3f>& planes_lidar) {
-  return add_keyframe(frame_index, T_world_lidar,
-                      make_scan_context(edges_lidar, planes_lidar, config_.descriptor));
+  return add_clouds(frame_index, T_world_lidar, edges_lidar, planes_lidar);
 }
 
 LoopQuery LoopDetector::add_keyframe(std::int64_t frame_index, const Eigen::Isometry3d& T_world_lidar,
                                      const std::vector<LidarPoint>& raw_points_lidar) {
-  return add_keyframe(frame_index, T_world_lidar,
-                      make_scan_context(raw_points_lidar, config_.descriptor));
+  return add_clouds(frame_index, T_world_lidar, raw_points_lidar);
 }
 
 LoopQuery LoopDetector::add_keyframe(std::int64_t frame_index, const Eigen::Isometry3d& T_world_lidar,
-                                     ScanContext descriptor) {
-  if (descriptor.bins.rows() != config_.descriptor.num_rings ||
-      descriptor.bins.cols() != config_.descriptor.num_sectors)
+                                     ScanContext descriptor,
+                                     const std::vector<ScanContext>& lateral_variants) {
+  const auto fits = [&](const ScanContext& d) {
+    return d.bins.rows() == config_.descriptor.num_rings && d.bins.cols() == config_.descriptor.num_sectors;
+  };
+  if (!fits(descriptor) || !std::all_of(lateral_variants.begin(), lateral_variants.end(), fits))
     throw Error("loop detection: descriptor size does not match the configuration");
   const int current_kf = static_cast<int>(size());
   index_.add(descriptor.ring_key);
@@ -53,14 +69,40 @@ LoopQuery LoopDetector::add_keyframe(std::int64_t frame_index, const Eigen::Isom
   frame_indices_.push_back(frame_index);
 
   LoopQuery query;
-  const ScanContext& current = descriptors_.back();
   const int eligible = current_kf - config_.exclude_recent_keyframes;
-  if (eligible <= 0 || current.empty()) return query;
+  if (eligible <= 0 || descriptors_.back().empty()) return query;
+
+  // Candidates: the ring-key neighbours of each query variant; each candidate is aligned with
+  // the variants that retrieved it, keeping the best.
+  std::vector<const ScanContext*> variants{&descriptors_.back()};
+  for (const ScanContext& v : lateral_variants)
+    if (!v.empty()) variants.push_back(&v);
+  struct Retrieved {
+    int loop_kf;
+    float ring_key_distance;
+    std::vector<const ScanContext*> by;
+  };
+  std::vector<Retrieved> retrieved;
+  for (const ScanContext* v : variants)
+    for (const RingKeyNeighbour& n :
+         index_.nearest(v->ring_key, config_.num_candidates, static_cast<std::size_t>(eligible))) {
+      auto it = std::find_if(retrieved.begin(), retrieved.end(),
+                             [&](const Retrieved& r) { return r.loop_kf == n.keyframe; });
+      if (it == retrieved.end()) {
+        retrieved.push_back({n.keyframe, n.distance, {v}});
+      } else {
+        it->ring_key_distance = std::min(it->ring_key_distance, n.distance);
+        it->by.push_back(v);
+      }
+    }
+  std::sort(retrieved.begin(), retrieved.end(), [](const Retrieved& a, const Retrieved& b) {
+    return a.ring_key_distance != b.ring_key_distance ? a.ring_key_distance < b.ring_key_distance
+                                                      : a.loop_kf < b.loop_kf;
+  });
 
   const double gate_m = gate_.threshold_m(size());
-  for (const RingKeyNeighbour& n :
-       index_.nearest(current.ring_key, config_.num_candidates, static_cast<std::size_t>(eligible)))
-    query.evaluated.push_back(evaluate(current, current_kf, n.keyframe, n.distance, gate_m));
+  for (const Retrieved& r : retrieved)
+    query.evaluated.push_back(evaluate(r.by, current_kf, r.loop_kf, r.ring_key_distance, gate_m));
 
   // The accepted candidate is the best score among those that passed both checks.
   LoopCandidate* best = nullptr;
@@ -74,10 +116,13 @@ LoopQuery LoopDetector::add_keyframe(std::int64_t frame_index, const Eigen::Isom
   return query;
 }
 
-LoopCandidate LoopDetector::evaluate(const ScanContext& current, int current_kf, int loop_kf,
-                                     float ring_key_distance, double gate_m) const {
-  const ColumnAlignment alignment =
-      align_scan_contexts(current, descriptors_[loop_kf], config_.fine_search_ratio);
+LoopCandidate LoopDetector::evaluate(const std::vector<const ScanContext*>& variants, int current_kf,
+                                     int loop_kf, float ring_key_distance, double gate_m) const {
+  ColumnAlignment alignment;
+  for (const ScanContext* v : variants) {
+    const ColumnAlignment a = align_scan_contexts(*v, descriptors_[loop_kf], config_.fine_search_ratio);
+    if (v == variants.front() || a.distance < alignment.distance) alignment = a;
+  }
   LoopCandidate c;
   c.current_kf = current_kf;
   c.loop_kf = loop_kf;
@@ -102,6 +147,18 @@ void LoopDetector::update_poses(const PoseList& T_world_keyframes) {
     throw Error("loop detection: " + std::to_string(T_world_keyframes.size()) +
                 " poses for " + std::to_string(size()) + " keyframes");
   std::copy(T_world_keyframes.begin(), T_world_keyframes.end(), T_world_keyframes_.begin());
+}
+
+std::vector<ScanContext> lateral_descriptors(const std::vector<Eigen::Vector3f>& points_lidar,
+                                             const LoopDetectionConfig& config) {
+  std::vector<ScanContext> variants;
+  if (config.lateral_augmentation_m > 0.0)
+    for (const double offset_m : {config.lateral_augmentation_m, -config.lateral_augmentation_m}) {
+      ScanContextBuilder shifted(config.descriptor, static_cast<float>(offset_m));
+      shifted.add(points_lidar);
+      variants.push_back(shifted.finish());
+    }
+  return variants;
 }
 
 std::vector<LoopCandidate> rows_to_log(const LoopQuery& query) {

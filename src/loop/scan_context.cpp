@@ -23,7 +23,8 @@ int wrap_index(int i, int n) { return ((i % n) + n) % n; }
 
 }  // namespace
 
-ScanContextBuilder::ScanContextBuilder(const ScanContextConfig& config) : config_(config) {
+ScanContextBuilder::ScanContextBuilder(const ScanContextConfig& config, float lateral_offset_m)
+    : config_(config), lateral_offset_m_(lateral_offset_m) {
   check_config(config_);
   ring_width_m_ = static_cast<float>(config_.max_radius_m / config_.num_rings);
   sector_width_rad_ = static_cast<float>(kTwoPi / config_.num_sectors);
@@ -32,7 +33,8 @@ ScanContextBuilder::ScanContextBuilder(const ScanContextConfig& config) : config
   bins_ = Eigen::MatrixXf::Zero(config_.num_rings, config_.num_sectors);
 }
 
-void ScanContextBuilder::add_point(float x, float y, float z) {
+void ScanContextBuilder::add_point(float x, float y_sensor, float z) {
+  const float y = y_sensor - lateral_offset_m_;
   const float r_sq = x * x + y * y;
   if (!(r_sq < max_radius_sq_) || r_sq <= 0.0f) return;  // also drops NaN
   float azimuth = std::atan2(y, x);

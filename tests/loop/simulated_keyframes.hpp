@@ -22,6 +22,8 @@ struct SimulatedKeyframes {
   std::vector<std::int64_t> frames;
   PoseList T_world_gt, T_world_odometry;
   std::vector<ScanContext> from_features, from_raw;
+  // Lateral variants (config.lateral_augmentation_m to the left and right) of both.
+  std::vector<std::vector<ScanContext>> features_lateral, raw_lateral;
   double end_drift_m = 0;
 };
 
@@ -65,6 +67,8 @@ inline SimulatedKeyframes simulate_keyframes(std::uint64_t seed, std::size_t fra
   const std::size_t n = out.frames.size();
   out.from_features.resize(n);
   out.from_raw.resize(n);
+  out.features_lateral.resize(n);
+  out.raw_lateral.resize(n);
   tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
     sim::SweepPoses poses;
     poses.T_world_lidar = out.T_world_gt[i];
@@ -73,22 +77,34 @@ inline SimulatedKeyframes simulate_keyframes(std::uint64_t seed, std::size_t fra
     FeatureExtractor extractor(PreprocessConfig{}, RingConfig{}, FeatureConfig{});
     FeatureCloud edges, planes;
     extractor.extract(scan.points, scan.has_ring, edges, planes);
-    out.from_features[i] = make_scan_context(voxel_downsample(edges, FeatureConfig{}.edge_leaf_m),
-                                             voxel_downsample(planes, FeatureConfig{}.plane_leaf_m),
-                                             config.descriptor);
+    FeatureCloud features = voxel_downsample(edges, FeatureConfig{}.edge_leaf_m);
+    const FeatureCloud plane_points = voxel_downsample(planes, FeatureConfig{}.plane_leaf_m);
+    features.insert(features.end(), plane_points.begin(), plane_points.end());
+    out.from_features[i] = make_scan_context(features, config.descriptor);
     out.from_raw[i] = make_scan_context(scan.points, config.descriptor);
+    out.features_lateral[i] = lateral_descriptors(features, config);
+    for (const double offset_m : {config.lateral_augmentation_m, -config.lateral_augmentation_m}) {
+      if (config.lateral_augmentation_m <= 0.0) break;
+      ScanContextBuilder shifted(config.descriptor, static_cast<float>(offset_m));
+      shifted.add(scan.points);
+      out.raw_lateral[i].push_back(shifted.finish());
+    }
   });
   return out;
 }
 
-// Runs a detector over the keyframes (gate on the odometry poses) and scores its verdicts.
+// Runs a detector over the keyframes (gate on the odometry poses) and scores its verdicts;
+// the lateral variants are used when config.lateral_augmentation_m > 0.
 inline LoopEvaluation detect_and_evaluate(const SimulatedKeyframes& kfs, const LoopDetectionConfig& config,
                                           bool from_features, std::vector<LoopCandidate>* accepted = nullptr) {
   LoopDetector detector(config);
   std::vector<LoopCandidate> evaluated;
+  const std::vector<ScanContext> none;
   for (std::size_t i = 0; i < kfs.frames.size(); ++i) {
+    const auto& lateral = from_features ? kfs.features_lateral[i] : kfs.raw_lateral[i];
     const LoopQuery query = detector.add_keyframe(kfs.frames[i], kfs.T_world_odometry[i],
-                                                  from_features ? kfs.from_features[i] : kfs.from_raw[i]);
+                                                  from_features ? kfs.from_features[i] : kfs.from_raw[i],
+                                                  config.lateral_augmentation_m > 0.0 ? lateral : none);
     evaluated.insert(evaluated.end(), query.evaluated.begin(), query.evaluated.end());
     if (accepted && query.best) accepted->push_back(*query.best);
   }

@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 
 #include "loop/synthetic_scene.hpp"
 #include "scfloam/error.hpp"
@@ -46,7 +47,9 @@ TEST(LoopDetector, DistinctPlacesAreNotMatched) {
   const auto query = detector.add_keyframe(5000, test::pose_xy_yaw(0, 0, 0),
                                            test::random_place(99999));
   EXPECT_FALSE(query.best.has_value());
-  ASSERT_EQ(query.evaluated.size(), 10u);
+  // 10 ring-key neighbours for the query and for each of its two lateral variants, merged.
+  ASSERT_GE(query.evaluated.size(), 10u);
+  ASSERT_LE(query.evaluated.size(), 30u);
   for (const auto& c : query.evaluated) {
     EXPECT_EQ(c.verdict, LoopVerdict::kRejectedScore);
     EXPECT_GT(c.sc_score, detector.config().score_threshold);
@@ -129,6 +132,48 @@ TEST(LoopDetector, OnlyTheBestPassingCandidateIsAccepted) {
   EXPECT_EQ(accepted, 1);
   EXPECT_EQ(rank, 1);
   EXPECT_EQ(rows_to_log(query).size(), 2u);
+}
+
+TEST(LoopDetector, LateralAugmentationFindsARevisitInTheOtherLane) {
+  // Place 0 revisited 3.2 m to the side, facing the other way (the opposite lane).
+  const auto world = test::random_place(100);
+  const auto current = test::view_from(world, test::pose_xy_yaw(0.0, 3.2, M_PI));
+  const double plain_score = [&] {
+    LoopDetectionConfig config;
+    config.lateral_augmentation_m = 0.0;
+    config.adaptive_gate = false;
+    LoopDetector detector(config);
+    fill_with_distinct_places(detector, 60, 100);
+    const auto query = detector.add_keyframe(600, test::pose_xy_yaw(0, 0, 0), current);
+    for (const auto& c : query.evaluated)
+      if (c.loop_kf == 0) return c.sc_score;
+    return 1.0;
+  }();
+  LoopDetectionConfig config;
+  config.adaptive_gate = false;
+  LoopDetector detector(config);
+  fill_with_distinct_places(detector, 60, 100);
+  const auto query = detector.add_keyframe(600, test::pose_xy_yaw(0, 0, 0), current);
+  ASSERT_TRUE(query.best.has_value());
+  EXPECT_EQ(query.best->loop_kf, 0);
+  EXPECT_LT(query.best->sc_score, plain_score);
+  EXPECT_LT(std::abs(std::remainder(query.best->yaw_rad - M_PI, 2 * M_PI)), 6.0 * M_PI / 180.0);
+  std::printf("other lane: score %.3f without, %.3f with lateral augmentation\n", plain_score,
+              query.best->sc_score);
+}
+
+TEST(LoopDetector, LateralDescriptorsMoveTheGridCentre) {
+  LoopDetectionConfig config;
+  config.lateral_augmentation_m = 3.0;
+  // A point 3 m to the left of the sensor is at the centre of the +3 m variant's grid and
+  // 6 m from the centre of the -3 m one (ring 1, 4..8 m).
+  const std::vector<Eigen::Vector3f> points = {{0.5f, 3.0f, 1.0f}};
+  const auto variants = lateral_descriptors(points, config);
+  ASSERT_EQ(variants.size(), 2u);
+  EXPECT_FLOAT_EQ(variants[0].bins.row(0).maxCoeff(), 3.0f);
+  EXPECT_FLOAT_EQ(variants[1].bins.row(1).maxCoeff(), 3.0f);
+  config.lateral_augmentation_m = 0.0;
+  EXPECT_TRUE(lateral_descriptors(points, config).empty());
 }
 
 }  // namespace

@@ -6,6 +6,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <sstream>
+#include <string>
 
 #include "loop/simulated_keyframes.hpp"
 #include "scfloam/stats.hpp"
@@ -71,20 +74,30 @@ TEST(LoopSequence, FeatureScanContextWithGateFindsRevisitsAndNoFalseLoop) {
   }
 }
 
-// The figures of docs/loop.md: full HDL-64 resolution, several seeds and thresholds.
+// The figures of docs/loop.md: full HDL-64 resolution, several seeds and thresholds, with
+// and without the lateral augmentation. Seeds come from SCFLOAM_LOOP_SEEDS ("4,5,6" default).
 // Run with --gtest_also_run_disabled_tests --gtest_filter='*FullResolution*' (minutes).
 TEST(LoopSequence, DISABLED_FullResolutionSweep) {
-  for (std::uint64_t seed : {4, 5, 6}) {
+  std::vector<std::uint64_t> seeds = {4, 5, 6};
+  if (const char* list = std::getenv("SCFLOAM_LOOP_SEEDS")) {
+    seeds.clear();
+    std::istringstream in(list);
+    for (std::string item; std::getline(in, item, ',');) seeds.push_back(std::stoull(item));
+  }
+  for (std::uint64_t seed : seeds) {
     const auto kfs = test::simulate_keyframes(seed, 2000, 0, LoopDetectionConfig{});
     std::printf("seed %llu: %zu keyframes, odometry drift at the end %.1f m\n",
                 static_cast<unsigned long long>(seed), kfs.frames.size(), kfs.end_drift_m);
-    for (double threshold : {0.2, 0.3, 0.4})
-      for (const Mode& mode : kModes) {
-        LoopDetectionConfig config;
-        config.score_threshold = threshold;
-        config.adaptive_gate = mode.adaptive_gate;
-        print_row(seed, threshold, mode, test::detect_and_evaluate(kfs, config, mode.from_features));
-      }
+    for (double lateral_m : {3.0, 0.0})
+      for (double threshold : {0.2, 0.3, 0.4})
+        for (const Mode& mode : kModes) {
+          LoopDetectionConfig config;
+          config.score_threshold = threshold;
+          config.adaptive_gate = mode.adaptive_gate;
+          config.lateral_augmentation_m = lateral_m;
+          std::printf("lateral %.0f m  ", lateral_m);
+          print_row(seed, threshold, mode, test::detect_and_evaluate(kfs, config, mode.from_features));
+        }
   }
 }
 

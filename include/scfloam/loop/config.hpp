@@ -22,6 +22,10 @@ struct LoopDetectionConfig {
   // from the raw scan (SC-A-LOAM / Simple-SC-F-LOAM baseline). The caller passes the points.
   bool descriptor_from_features = true;
 
+  // The query is also described from virtual sensors this far to the left and the right
+  // (0 = off): a revisit in the opposite lane, ~3 m aside, otherwise scores 0.4-0.5.
+  double lateral_augmentation_m = 3.0;
+
   int exclude_recent_keyframes = 50;  // the newest keyframes are never loop candidates
   int num_candidates = 10;            // ring-key nearest neighbours aligned per query
   int tree_rebuild_every = 50;        // k-d tree rebuilt once this many keyframes are unindexed

@@ -37,8 +37,10 @@ class LoopDetector {
                          const std::vector<Eigen::Vector3f>& planes_lidar);
   LoopQuery add_keyframe(std::int64_t frame_index, const Eigen::Isometry3d& T_world_lidar,
                          const std::vector<LidarPoint>& raw_points_lidar);
+  // With a precomputed descriptor; `lateral_variants` are the query's laterally shifted
+  // descriptors (lateral_descriptors()), empty = no augmentation.
   LoopQuery add_keyframe(std::int64_t frame_index, const Eigen::Isometry3d& T_world_lidar,
-                         ScanContext descriptor);
+                         ScanContext descriptor, const std::vector<ScanContext>& lateral_variants = {});
 
   // After pose-graph optimization: new poses of keyframes 0 .. poses.size()-1 (the gate uses them).
   void update_poses(const PoseList& T_world_keyframes);
@@ -50,7 +52,10 @@ class LoopDetector {
   const LoopDetectionConfig& config() const { return config_; }
 
  private:
-  LoopCandidate evaluate(const ScanContext& current, int current_kf, int loop_kf,
+  template <class... Clouds>
+  LoopQuery add_clouds(std::int64_t frame_index, const Eigen::Isometry3d& T_world_lidar,
+                       const Clouds&... clouds);
+  LoopCandidate evaluate(const std::vector<const ScanContext*>& variants, int current_kf, int loop_kf,
                          float ring_key_distance, double gate_m) const;
 
   LoopDetectionConfig config_;
@@ -60,6 +65,11 @@ class LoopDetector {
   PoseList T_world_keyframes_;
   std::vector<std::int64_t> frame_indices_;
 };
+
+// Descriptors of the points from virtual sensors at +-config.lateral_augmentation_m along the
+// lidar's y axis (none when it is 0).
+std::vector<ScanContext> lateral_descriptors(const std::vector<Eigen::Vector3f>& points_lidar,
+                                             const LoopDetectionConfig& config);
 
 // Rows worth a line in loops.csv for one query: every candidate that passed the score
 // threshold, or else the single best-scoring one (so each keyframe with candidates leaves a

@@ -21,10 +21,12 @@ struct ScanContext {
 
 // Accumulates points (lidar frame, z up) into the grid; several clouds may be added, e.g. the
 // edge and the plane feature clouds of one keyframe. Sector 0 starts at azimuth 0 (+x) and
-// sectors grow counter-clockwise (towards +y).
+// sectors grow counter-clockwise (towards +y). A non-zero `lateral_offset_m` centres the grid
+// at (0, lateral_offset_m): a virtual sensor one lane to the side (Scan Context++'s lateral
+// augmentation), for revisits driven in another lane.
 class ScanContextBuilder {
  public:
-  explicit ScanContextBuilder(const ScanContextConfig& config);
+  explicit ScanContextBuilder(const ScanContextConfig& config, float lateral_offset_m = 0.0f);
   void add(const std::vector<Eigen::Vector3f>& points_lidar);
   void add(const std::vector<LidarPoint>& points_lidar);
   ScanContext finish() const;  // computes the keys; the builder can keep accumulating
@@ -32,6 +34,7 @@ class ScanContextBuilder {
  private:
   void add_point(float x, float y, float z);
   ScanContextConfig config_;
+  float lateral_offset_m_;
   float ring_width_m_, sector_width_rad_, max_radius_sq_;
   Eigen::MatrixXf bins_;
 };
