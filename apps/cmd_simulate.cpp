@@ -42,7 +42,8 @@ scfloam::cli::RegisterCommand reg("simulate", [](CLI::App& app) {
   auto* sub = app.add_subcommand("simulate", "Simulate a LiDAR sequence in a procedural city (KITTI layout + ground truth)");
   sub->add_option("--out", args->out, "Output sequence directory")->required();
   sub->add_option("--frames", args->config.frames, "Number of scans (10 Hz); replay: at most this many")
-      ->each([args](const std::string&) { args->frames_given = true; });
+      ->each([args](const std::string&) { args->frames_given = true; })
+      ->capture_default_str();
   sub->add_option("--seed", args->config.seed, "World, route and noise seed")->capture_default_str();
   sub->add_option("--route", args->config.route, "loops | straight | kitti")
       ->check(CLI::IsMember({"loops", "straight", "kitti"}))->capture_default_str();
