@@ -34,13 +34,14 @@ LoopMatch register_loop_features(const KeyframeView& current,
 
   // The submap lives in the loop keyframe's frame, so the result is T_loop_current directly.
   const Eigen::Isometry3d T_loop_world = submap[loop_index].T_world_lidar.inverse();
-  // Coarse: wider correspondence search (cells hold proportionally more points).
+  // Coarse: correspondences within a wider radius, on a map thinned by the same factor, so
+  // that a cell holds about as many points as a fine one and queries cost about the same.
   RegistrationConfig coarse = registration;
   coarse.max_neighbor_dist_m = std::max(config.coarse_radius_m, registration.max_neighbor_dist_m);
-  LocalMapConfig coarse_map_config = map_config;
   const double widening = coarse.max_neighbor_dist_m / registration.max_neighbor_dist_m;
-  coarse_map_config.max_points_per_cell =
-      static_cast<int>(std::ceil(map_config.max_points_per_cell * widening * widening * widening));
+  LocalMapConfig coarse_map_config = map_config;
+  coarse_map_config.edge_spacing_m *= widening;
+  coarse_map_config.plane_spacing_m *= widening;
   FeatureMap coarse_map(coarse, coarse_map_config), fine_map(registration, map_config);
   static const FeatureCloud kEmpty;
   for (const auto& kf : submap) {
