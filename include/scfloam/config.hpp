@@ -54,6 +54,9 @@ struct RegistrationConfig {
   int inner_iterations = 4;          // Ceres iterations per correspondence round
   int outer_iterations = 2;          // correspondence rounds per frame in steady state
   int outer_iterations_initial = 12; // rounds on the first frame, decreasing by one per frame
+  // A point's match is kept from the previous round when the point moved less than this
+  // (0 = search every round): later rounds move the pose by millimetres.
+  double match_refresh_m = 0.05;
   // Stop the rounds early once one moves the pose less than both of these.
   double converged_translation_m = 0.001;
   double converged_rotation_deg = 0.01;

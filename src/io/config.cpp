@@ -51,6 +51,7 @@ std::vector<Binding> bindings(SlamConfig& c) {
       {reg, "inner_iterations", &o.registration.inner_iterations},
       {reg, "outer_iterations", &o.registration.outer_iterations},
       {reg, "outer_iterations_initial", &o.registration.outer_iterations_initial},
+      {reg, "match_refresh_m", &o.registration.match_refresh_m},
       {reg, "converged_translation_m", &o.registration.converged_translation_m},
       {reg, "converged_rotation_deg", &o.registration.converged_rotation_deg},
       {reg, "degeneracy_min_eigenvalue", &o.registration.degeneracy_min_eigenvalue},

@@ -83,7 +83,11 @@ OdometryResult Odometry::process(const Scan& scan) {
     s.T_delta = orthonormalized(s.T_last.inverse() * result.T_world_lidar);
     s.delta_dt_s = scan.timestamp_s - s.last_stamp_s;
   }
-  s.map.insert(result.edges, result.planes, result.T_world_lidar);
+  // The first frame seeds the map with its full-density features: frame 1 starts from a
+  // zero-velocity guess, often 1 m off, and a map of one downsampled frame is too sparse to
+  // pull it in (KITTI 08 frame 1: 6.7 -> see docs/odometry.md).
+  if (s.frames == 0) s.map.insert(s.raw_edges, s.raw_planes, result.T_world_lidar);
+  else s.map.insert(result.edges, result.planes, result.T_world_lidar);
   // Dropping far cells walks the whole map: do it every 10 m of travel, not every frame.
   const Eigen::Vector3d position = result.T_world_lidar.translation();
   if ((position - s.last_cleanup_position).norm() > 10.0) {

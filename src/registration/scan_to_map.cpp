@@ -69,21 +69,31 @@ LocalShape local_shape(const VoxelMap::Neighbors& nb) {
 
 void ScanToMapRegistration::find_matches(const FeatureCloud& edges, const FeatureCloud& planes,
                                          const FeatureMap& map,
-                                         const Eigen::Isometry3d& T_world_lidar) {
+                                         const Eigen::Isometry3d& T_world_lidar,
+                                         bool first_round) {
   const Eigen::Isometry3f T = T_world_lidar.cast<float>();
   const int k = config_.knn;
   const float radius = static_cast<float>(config_.max_neighbor_dist_m);
-  edge_all_.resize(edges.size());
-  plane_all_.resize(planes.size());
-  edge_ok_.assign(edges.size(), 0);
-  plane_ok_.assign(planes.size(), 0);
+  const float refresh2 = static_cast<float>(config_.match_refresh_m * config_.match_refresh_m);
+  if (first_round) {
+    edge_all_.resize(edges.size());
+    plane_all_.resize(planes.size());
+    edge_ok_.assign(edges.size(), 0);
+    plane_ok_.assign(planes.size(), 0);
+    edge_query_.resize(edges.size());
+    plane_query_.resize(planes.size());
+  }
 
   const std::size_t n_edges = edges.size(), total = edges.size() + planes.size();
   auto work = [&](const tbb::blocked_range<std::size_t>& range) {
     VoxelMap::Neighbors nb;
     for (std::size_t i = range.begin(); i != range.end(); ++i) {
       if (i < n_edges) {
-        map.edges().knn(T * edges[i], k, radius, nb);
+        const Eigen::Vector3f q = T * edges[i];
+        if (!first_round && (q - edge_query_[i]).squaredNorm() < refresh2) continue;
+        edge_query_[i] = q;
+        edge_ok_[i] = 0;
+        map.edges().knn(q, k, radius, nb);
         if (nb.count < k) continue;
         const LocalShape s = local_shape(nb);
         if (!(s.eigenvalues[2] > config_.edge_line_ratio * s.eigenvalues[1])) continue;
@@ -91,7 +101,11 @@ void ScanToMapRegistration::find_matches(const FeatureCloud& edges, const Featur
         edge_ok_[i] = 1;
       } else {
         const std::size_t j = i - n_edges;
-        map.planes().knn(T * planes[j], k, radius, nb);
+        const Eigen::Vector3f q = T * planes[j];
+        if (!first_round && (q - plane_query_[j]).squaredNorm() < refresh2) continue;
+        plane_query_[j] = q;
+        plane_ok_[j] = 0;
+        map.planes().knn(q, k, radius, nb);
         if (nb.count < k) continue;
         const LocalShape s = local_shape(nb);
         const Eigen::Vector3d n = s.eigenvectors.col(0);
@@ -131,7 +145,7 @@ RegistrationResult ScanToMapRegistration::align(const FeatureCloud& edges_lidar,
   constexpr std::size_t kMinMatches = 10;  // fewer cannot pin down 6 dof with any margin
 
   for (int round = 0; round < rounds; ++round) {
-    find_matches(edges_lidar, planes_lidar, map, block_to_pose(pose));
+    find_matches(edges_lidar, planes_lidar, map, block_to_pose(pose), round == 0);
     if (edge_out_.size() + plane_out_.size() < kMinMatches) break;
     FeatureCost cost(edge_out_, plane_out_, config_.huber_delta_m);
     ceres::Problem::Options problem_options;

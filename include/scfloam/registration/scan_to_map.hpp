@@ -60,12 +60,13 @@ class ScanToMapRegistration {
 
  private:
   void find_matches(const FeatureCloud& edges, const FeatureCloud& planes, const FeatureMap& map,
-                    const Eigen::Isometry3d& T_world_lidar);
+                    const Eigen::Isometry3d& T_world_lidar, bool first_round);
 
   RegistrationConfig config_;
   std::vector<EdgeMatch> edge_all_, edge_out_;
   std::vector<PlaneMatch> plane_all_, plane_out_;
   std::vector<char> edge_ok_, plane_ok_;
+  std::vector<Eigen::Vector3f> edge_query_, plane_query_;  // world position at the last search
 };
 
 // One-off convenience: `rounds` correspondence rounds from T_world_lidar_init.
