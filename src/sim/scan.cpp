@@ -57,14 +57,14 @@ Scan render_scan(const World& world, const SensorModel& sensor, const BeamCalibr
         double p_drop = sensor.dropout_prob;
         if (cos_inc < 0.1) p_drop += 0.6 * (1 - cos_inc / 0.1);
         const double far = std::max(1.0, hit.range_m / 30.0);
-        if (hit.reflectance * std::max(cos_inc, 0.05) / (far * far) < 0.002) continue;
+        if (hit.reflectance * std::max(cos_inc, 0.05) / (far * far) < 0.004) continue;
         if (rng.uniform() < p_drop) continue;
         const double range = hit.range_m + calib.range_bias_m[b] + rng.normal(0, sensor.range_noise_m);
         if (range < sensor.min_range_m || range > sensor.max_range_m) continue;
         // The driver reports the point along the nominal beam direction, in the sensor frame
         // at the firing time: with motion distortion that frame moves during the sweep.
         const Eigen::Vector3d p = range * Eigen::Vector3d(cos_el[b] * cos_az, cos_el[b] * sin_az, sin_el[b]);
-        const double intensity = hit.reflectance * (0.35 + 0.65 * cos_inc) + rng.normal(0, 0.02);
+        const double intensity = hit.reflectance * (0.6 + 0.4 * cos_inc) + rng.normal(0, 0.02);
         LidarPoint& out = slots[static_cast<std::size_t>(b) * columns + c];
         out.x = static_cast<float>(p.x());
         out.y = static_cast<float>(p.y());
