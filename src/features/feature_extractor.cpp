@@ -122,22 +122,18 @@ void FeatureExtractor::select_in_ring(int ring) {
   if (n < min_points_per_ring_ || n < 2 * hw + 1 + feat_.sectors_per_ring) return;
   const Eigen::Vector3f* p = ordered_.data() + begin;
   float* curv = curvature_.data() + begin;
-  float* range = range_.data() + begin;
   char* picked = picked_.data() + begin;
   char* unreliable = unreliable_.data() + begin;
   ring_curvature(p, n, hw, curv);
-  for (int i = 0; i < n; ++i) {
-    range[i] = p[i].norm();
-    picked[i] = 0;
-    unreliable[i] = 0;
-  }
+  std::fill(picked, picked + n, 0);
+  std::fill(unreliable, unreliable + n, 0);
   if (feat_.reject_occluded) {
     // LOAM's occlusion test: at a depth jump between neighbours seen at the same bearing, the
     // far side's points are hidden or revealed as the sensor moves: never edges.
     const float ratio = static_cast<float>(feat_.occlusion_gap_ratio);
     for (int i = hw; i < n - hw - 1; ++i) {
       if ((p[i + 1] - p[i]).squaredNorm() <= 0.1f) continue;
-      const float d1 = range[i], d2 = range[i + 1];
+      const float d1 = p[i].norm(), d2 = p[i + 1].norm();
       if (d1 > d2) {
         if ((p[i + 1] - p[i] * (d2 / d1)).norm() / d2 < ratio)
           for (int k = std::max(0, i - hw); k <= i; ++k) unreliable[k] = 1;
@@ -186,7 +182,6 @@ void FeatureExtractor::extract(const std::vector<LidarPoint>& points, bool use_r
   assign_rings(points, use_ring_field);
   stats_.kept_points = static_cast<int>(ordered_.size());
   curvature_.resize(ordered_.size());
-  range_.resize(ordered_.size());
   picked_.resize(ordered_.size());
   unreliable_.resize(ordered_.size());
   for (int r = 0; r < beams_; ++r) order_ring_by_azimuth(r);

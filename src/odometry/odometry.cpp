@@ -85,7 +85,7 @@ OdometryResult Odometry::process(const Scan& scan) {
   }
   // The first frame seeds the map with its full-density features: frame 1 starts from a
   // zero-velocity guess, often 1 m off, and a map of one downsampled frame is too sparse to
-  // pull it in (KITTI 08 frame 1: 6.7 -> see docs/odometry.md).
+  // pull it in (docs/odometry.md, "First frame").
   if (s.frames == 0) s.map.insert(s.raw_edges, s.raw_planes, result.T_world_lidar);
   else s.map.insert(result.edges, result.planes, result.T_world_lidar);
   // Dropping far cells walks the whole map: do it every 10 m of travel, not every frame.

@@ -48,7 +48,7 @@ class FeatureExtractor {
   std::vector<std::int16_t> ring_of_;        // per input point, -1 = dropped
   std::vector<int> ring_begin_;              // offsets into ordered_ (beams_ + 1)
   std::vector<Eigen::Vector3f> ordered_;     // kept points grouped by ring
-  std::vector<float> curvature_, range_;
+  std::vector<float> curvature_;
   std::vector<char> picked_, unreliable_;
   std::vector<std::vector<int>> candidates_;     // per ring scratch
   std::vector<FeatureCloud> ring_edges_, ring_planes_;
