@@ -27,7 +27,7 @@ struct SimulatedKeyframes {
   double end_drift_m = 0;
 };
 
-// Odometry that drifts like a ~1 % front end: scale error and a steady yaw bias per metre.
+// Odometry that drifts: a scale error and a steady yaw bias per metre travelled.
 inline PoseList drifting_odometry(const PoseList& gt, double scale_error, double yaw_bias_deg_per_100m) {
   PoseList odometry{gt.front()};
   for (std::size_t k = 1; k < gt.size(); ++k) {
