@@ -94,12 +94,13 @@ std::vector<RingKeyNeighbour> RingKeyIndex::nearest(const Eigen::VectorXf& query
                 std::to_string(key_size_));
   maybe_rebuild(eligible);
 
-  // Distances are recomputed one way for tree hits and tail alike, so the order does not
-  // depend on which keys happen to be in the tree.
+  // Distances are recomputed one way for tree hits and tail alike, and the tree is asked for
+  // 2k, so that rounding in its own distances cannot change the k kept: the answer does not
+  // depend on which keys happen to be in the tree (the background rebuild's timing).
   std::vector<RingKeyNeighbour> found;
   const std::size_t indexed = tree_size();
   if (indexed > 0) {
-    const std::size_t want = std::min<std::size_t>(k, indexed);
+    const std::size_t want = std::min<std::size_t>(2 * static_cast<std::size_t>(k), indexed);
     std::vector<std::uint32_t> ids(want);
     std::vector<float> dist_sq(want);
     const std::size_t got = tree_->index->knnSearch(query.data(), want, ids.data(), dist_sq.data());
