@@ -16,6 +16,19 @@ void check_config(const LoopDetectionConfig& c) {
                 "fine_search_ratio >= 0 and score_threshold >= 0");
 }
 
+// The query seen from virtual sensors +-lateral_augmentation_m along the lidar's y axis.
+template <class... Clouds>
+std::vector<ScanContext> shifted_descriptors(const LoopDetectionConfig& config, const Clouds&... clouds) {
+  std::vector<ScanContext> variants;
+  if (config.lateral_augmentation_m <= 0.0) return variants;
+  for (const double offset_m : {config.lateral_augmentation_m, -config.lateral_augmentation_m}) {
+    ScanContextBuilder shifted(config.descriptor, static_cast<float>(offset_m));
+    (shifted.add(clouds), ...);
+    variants.push_back(shifted.finish());
+  }
+  return variants;
+}
+
 }  // namespace
 
 LoopDetector::LoopDetector(const LoopDetectionConfig& config)
@@ -28,14 +41,7 @@ LoopQuery LoopDetector::add_clouds(std::int64_t frame_index, const Eigen::Isomet
                                    const Clouds&... clouds) {
   ScanContextBuilder builder(config_.descriptor);
   (builder.add(clouds), ...);
-  std::vector<ScanContext> variants;
-  if (config_.lateral_augmentation_m > 0.0)
-    for (const double offset_m : {config_.lateral_augmentation_m, -config_.lateral_augmentation_m}) {
-      ScanContextBuilder shifted(config_.descriptor, static_cast<float>(offset_m));
-      (shifted.add(clouds), ...);
-      variants.push_back(shifted.finish());
-    }
-  return add_keyframe(frame_index, T_world_lidar, builder.finish(), variants);
+  return add_keyframe(frame_index, T_world_lidar, builder.finish(), shifted_descriptors(config_, clouds...));
 }
 
 LoopQuery LoopDetector::add_keyframe(std::int64_t frame_index, const Eigen::Isometry3d& T_world_lidar,
@@ -151,14 +157,7 @@ void LoopDetector::update_poses(const PoseList& T_world_keyframes) {
 
 std::vector<ScanContext> lateral_descriptors(const std::vector<Eigen::Vector3f>& points_lidar,
                                              const LoopDetectionConfig& config) {
-  std::vector<ScanContext> variants;
-  if (config.lateral_augmentation_m > 0.0)
-    for (const double offset_m : {config.lateral_augmentation_m, -config.lateral_augmentation_m}) {
-      ScanContextBuilder shifted(config.descriptor, static_cast<float>(offset_m));
-      shifted.add(points_lidar);
-      variants.push_back(shifted.finish());
-    }
-  return variants;
+  return shifted_descriptors(config, points_lidar);
 }
 
 std::vector<LoopCandidate> rows_to_log(const LoopQuery& query) {
