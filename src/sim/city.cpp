@@ -171,10 +171,10 @@ class Placer {
   void tree(Rng& rng, const Vec2& p) {
     const double g = ground(p), trunk_h = rng.uniform(2.2, 3.5);
     const double rxy = rng.uniform(1.5, 3.5), rz = rng.uniform(1.5, 3.0);
-    w_.primitives.push_back(make_cylinder(p.x(), p.y(), rng.uniform(0.12, 0.3), g - 1, g + trunk_h + rz,
+    w_.primitives.push_back(make_cylinder(p.x(), p.y(), rng.uniform(0.12, 0.3), g - 1, g + trunk_h + 1.5 * rz,
                                           SurfaceKind::trunk, static_cast<float>(rng.uniform(0.25, 0.4))));
     w_.primitives.push_back(make_ellipsoid(p.x() + rng.uniform(-0.3, 0.3), p.y() + rng.uniform(-0.3, 0.3),
-                                           g + trunk_h + 0.8 * rz, rxy, rz, SurfaceKind::vegetation,
+                                           g + trunk_h + rz, rxy, rz, SurfaceKind::vegetation,
                                            static_cast<float>(rng.uniform(0.35, 0.6)),
                                            static_cast<float>(rng.uniform(0.5, 1.5))));
     ++stats_.trees;
@@ -297,6 +297,7 @@ class Placer {
       if (s.parking)
         for (double u = rng.uniform(3, 10); u < L; u += rng.uniform(5.5, 8.5)) {
           if (rng.chance(0.35)) continue;
+          if (u < 25 || u > L - 25) continue;  // no parking near intersections (turning cars)
           frame(u, &p, &t, &n);
           const Vec2 c = p + n * (s.half_width_m - 1.15);
           if (edge(c) > -0.6 || edge(c) < -1.7) continue;

@@ -28,17 +28,88 @@ std::vector<Vec2> edge_line(Rng& rng, const Vec2& a, const Vec2& b) {
   if (!rng.chance(0.2)) return {a, b};
   const Vec2 d = b - a;
   const Vec2 ctrl = 0.5 * (a + b) + Vec2(-d.y(), d.x()) * rng.uniform(-0.16, 0.16);
+  // Long first and last chords leave room to round the corners at both intersections.
   std::vector<Vec2> out;
-  for (int i = 0; i <= 12; ++i) {
-    const double u = i / 12.0;
+  for (double u : {0.0, 0.25, 0.3125, 0.375, 0.4375, 0.5, 0.5625, 0.625, 0.6875, 0.75, 1.0})
     out.push_back((1 - u) * (1 - u) * a + 2 * u * (1 - u) * ctrl + u * u * b);
-  }
   return out;
 }
 
+// Rounds every corner of a street polyline with a circular arc of radius_m (smaller where
+// the neighbouring segments are short), so the driven path stays inside intersections.
+std::vector<Vec2> fillet_corners(const std::vector<Vec2>& pts, double radius_m) {
+  std::vector<Vec2> in;
+  for (const auto& p : pts)
+    if (in.empty() || (p - in.back()).norm() > 1e-6) in.push_back(p);
+  if (in.size() < 3) return in;
+  std::vector<Vec2> out{in.front()};
+  for (std::size_t i = 1; i + 1 < in.size(); ++i) {
+    const Vec2 d1 = (in[i] - in[i - 1]).normalized(), d2 = (in[i + 1] - in[i]).normalized();
+    const double cross = d1.x() * d2.y() - d1.y() * d2.x();
+    const double turn = std::atan2(cross, d1.dot(d2));  // signed, left positive
+    if (std::abs(turn) < 1e-3) {
+      out.push_back(in[i]);
+      continue;
+    }
+    const double half_tan = std::tan(std::abs(turn) / 2);
+    const double tangent = std::min({radius_m * half_tan, 0.45 * (in[i] - in[i - 1]).norm(),
+                                     0.45 * (in[i + 1] - in[i]).norm()});
+    const double r = tangent / half_tan;
+    const Vec2 start = in[i] - d1 * tangent;
+    const Vec2 left(-d1.y(), d1.x());
+    const Vec2 center = start + left * (turn > 0 ? r : -r);
+    const int steps = std::max(2, static_cast<int>(std::abs(turn) * r / 0.5));
+    for (int k = 0; k <= steps; ++k) {
+      const double a = turn * k / steps;
+      const Vec2 rel = start - center;
+      out.push_back(center + Vec2(std::cos(a) * rel.x() - std::sin(a) * rel.y(), std::sin(a) * rel.x() + std::cos(a) * rel.y()));
+    }
+  }
+  out.push_back(in.back());
+  return out;
+}
+
+double max_curvature(const std::vector<Vec2>& p) {
+  double worst = 0;
+  for (std::size_t i = 4; i + 4 < p.size(); ++i) {
+    const Vec2 a = p[i] - p[i - 4], b = p[i + 4] - p[i];
+    const double turn = std::abs(std::atan2(a.x() * b.y() - a.y() * b.x(), a.dot(b)));
+    worst = std::max(worst, turn / (0.5 * (a.norm() + b.norm())));
+  }
+  return worst;
+}
+
 std::vector<Vec2> drive_lane(const std::vector<Vec2>& centerline) {
-  // sigma 10 m turns a street corner into a ~9 m radius curve (<= 0.6 rad/s at 5 m/s).
-  return smooth_path(offset_path(smooth_path(centerline, 0.5, 10.0), kLaneOffset), 0.5, 1.5);
+  // Corners become 11 m arcs (the right lane turns at ~9.4 m right, ~12.6 m left: <= 0.55
+  // rad/s at 5 m/s, inside the intersection); a light gaussian then eases the curvature in.
+  std::vector<Vec2> lane =
+      smooth_path(offset_path(smooth_path(fillet_corners(centerline, 11.0), 0.5, 0.5), kLaneOffset), 0.5, 3.0);
+  // Skewed corners next to short segments got smaller arcs: ease them (only there, within
+  // 20 m, so other corners are not cut) until the radius is >= 8 m.
+  for (int pass = 0; pass < 8 && max_curvature(lane) > 1.0 / 8.0; ++pass) {
+    const int n = static_cast<int>(lane.size()), reach = 40;  // samples are ~0.5 m apart
+    std::vector<Vec2> eased(n);
+    for (int i = 0; i < n; ++i) {  // gaussian, sigma 8 samples (~4 m), same indices
+      Vec2 acc = Vec2::Zero();
+      double wsum = 0;
+      for (int k = -24; k <= 24; ++k) {
+        const double w = std::exp(-0.5 * (k / 8.0) * (k / 8.0));
+        acc += w * lane[std::clamp(i + k, 0, n - 1)];
+        wsum += w;
+      }
+      eased[i] = acc / wsum;
+    }
+    std::vector<double> weight(n, 0.0);
+    for (int i = 4; i + 4 < n; ++i) {
+      const Vec2 a = lane[i] - lane[i - 4], b = lane[i + 4] - lane[i];
+      const double k = std::abs(std::atan2(a.x() * b.y() - a.y() * b.x(), a.dot(b))) / (0.5 * (a.norm() + b.norm()));
+      if (k <= 1.0 / 8.0) continue;
+      for (int j = std::max(0, i - reach); j < std::min(n, i + reach); ++j)
+        weight[j] = std::max(weight[j], 1.0 - std::abs(j - i) / static_cast<double>(reach));
+    }
+    for (int i = 0; i < n; ++i) lane[i] = (1 - weight[i]) * lane[i] + weight[i] * eased[i];
+  }
+  return lane;
 }
 
 double path_length(const std::vector<Vec2>& p) {

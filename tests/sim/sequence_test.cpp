@@ -89,7 +89,7 @@ TEST_F(SimulatedSequence, WallsAccumulatedWithGroundTruthStayThin) {
     const Eigen::Vector2d to_start = start.head<2>() - c;
     const Eigen::Vector2d n = across.dot(to_start) > 0 ? across : Eigen::Vector2d(-across);
     const double dist = (start.head<2>() - (c + n * p.hy)).norm();
-    if (dist > 60) continue;
+    if (dist > 80) continue;
     // Only a facade nothing else touches (pillars, foliage, neighbours would sit in the band).
     const Eigen::Vector2d e1 = c + n * p.hy + along * p.hx, e2 = c + n * p.hy - along * p.hx;
     const double bx0 = std::min(e1.x(), e2.x()) - 0.6, bx1 = std::max(e1.x(), e2.x()) + 0.6;
