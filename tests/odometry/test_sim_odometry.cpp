@@ -78,6 +78,8 @@ TEST(SimOdometry, DistortedScansWithDeskewAndRingField) {
   odo.preprocess.deskew = true;
   const Drift d = run_sim(cfg, odo, /*use_rings=*/true);
   EXPECT_LT(d.end_error_m / d.path_m, 0.01);
+  // Frames 0-1 cannot be deskewed (no velocity yet) and stay in the map: frames 3-5 show a
+  // ~1 cm transient (docs/odometry.md); later frames are at 2-3 mm.
   EXPECT_LT(d.max_frame_error_m, 0.03);
 }
 
