@@ -27,7 +27,7 @@ std::vector<Binding> bindings(SlamConfig& c) {
   const std::string pre = "odometry.preprocess", ring = "odometry.rings",
                     feat = "odometry.features", reg = "odometry.registration",
                     map = "odometry.map";
-  return {
+  std::vector<Binding> table{
       {pre, "min_range_m", &o.preprocess.min_range_m},
       {pre, "max_range_m", &o.preprocess.max_range_m},
       {pre, "deskew", &o.preprocess.deskew},
@@ -61,6 +61,63 @@ std::vector<Binding> bindings(SlamConfig& c) {
       {map, "max_points_per_cell", &o.map.max_points_per_cell},
       {map, "radius_m", &o.map.radius_m},
   };
+  auto& d = c.loop_detection;
+  const std::string det = "loop_detection", sc = "loop_detection.descriptor";
+  table.insert(table.end(), {
+      {sc, "num_rings", &d.descriptor.num_rings},
+      {sc, "num_sectors", &d.descriptor.num_sectors},
+      {sc, "max_radius_m", &d.descriptor.max_radius_m},
+      {sc, "sensor_height_m", &d.descriptor.sensor_height_m},
+      {det, "keyframe_distance_m", &d.keyframe_distance_m},
+      {det, "keyframe_angle_deg", &d.keyframe_angle_deg},
+      {det, "descriptor_from_features", &d.descriptor_from_features},
+      {det, "lateral_augmentation_m", &d.lateral_augmentation_m},
+      {det, "exclude_recent_keyframes", &d.exclude_recent_keyframes},
+      {det, "num_candidates", &d.num_candidates},
+      {det, "tree_rebuild_every", &d.tree_rebuild_every},
+      {det, "tree_rebuild_async", &d.tree_rebuild_async},
+      {det, "fine_search_ratio", &d.fine_search_ratio},
+      {det, "score_threshold", &d.score_threshold},
+      {det, "adaptive_gate", &d.adaptive_gate},
+      {det, "gate_base_m", &d.gate_base_m},
+      {det, "gate_keyframes_per_m", &d.gate_keyframes_per_m},
+      {det, "fixed_gate_m", &d.fixed_gate_m},
+  });
+  auto& l = c.loop_registration;
+  const std::string lr = "loop_registration";
+  table.insert(table.end(), {
+      {lr, "submap_neighbors", &l.submap_neighbors},
+      {lr, "coarse_radius_m", &l.coarse_radius_m},
+      {lr, "coarse_rounds", &l.coarse_rounds},
+      {lr, "rounds", &l.rounds},
+      {lr, "min_inlier_fraction", &l.min_inlier_fraction},
+      {lr, "max_mean_residual_m", &l.max_mean_residual_m},
+      {lr, "icp_leaf_m", &l.icp_leaf_m},
+      {lr, "icp_max_correspondence_m", &l.icp_max_correspondence_m},
+      {lr, "icp_max_iterations", &l.icp_max_iterations},
+      {lr, "icp_max_fitness_m2", &l.icp_max_fitness_m2},
+  });
+  auto& g = c.pose_graph;
+  const std::string pg = "pose_graph";
+  table.insert(table.end(), {
+      {pg, "odometry_rotation_sigma_rad", &g.odometry_rotation_sigma_rad},
+      {pg, "odometry_translation_sigma_m", &g.odometry_translation_sigma_m},
+      {pg, "loop_rotation_sigma_rad", &g.loop_rotation_sigma_rad},
+      {pg, "loop_translation_sigma_m", &g.loop_translation_sigma_m},
+      {pg, "loop_cauchy_scale", &g.loop_cauchy_scale},
+      {pg, "loop_outlier_chi2", &g.loop_outlier_chi2},
+      {pg, "max_outlier_rounds", &g.max_outlier_rounds},
+      {pg, "max_iterations", &g.max_iterations},
+  });
+  auto& p = c.pipeline;
+  const std::string pl = "pipeline";
+  table.insert(table.end(), {
+      {pl, "deterministic", &p.deterministic},
+      {pl, "queue_capacity", &p.queue_capacity},
+      {pl, "rebuild_map_after_loop", &p.rebuild_map_after_loop},
+      {pl, "raw_leaf_m", &p.raw_leaf_m},
+  });
+  return table;
 }
 
 std::vector<std::string> split_dots(const std::string& s) {

@@ -38,7 +38,9 @@ struct LoopDetectionConfig {
   bool adaptive_gate = true;
   double gate_base_m = 20.0;
   double gate_keyframes_per_m = 40.0;  // the paper's n
-  double fixed_gate_m = 1e9;           // effectively no gate (SC-A-LOAM) unless configured
+  // The baseline's fixed gate: 60 m, as the paper's public code uses for its 16-beam variant
+  // (SC-A-LOAM itself has none: set 1e9 for that).
+  double fixed_gate_m = 60.0;
 };
 
 }  // namespace scfloam
