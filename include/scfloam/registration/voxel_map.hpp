@@ -50,15 +50,17 @@ class VoxelMap {
     std::uint32_t count = 0;
   };
 
-  const Eigen::Vector3f* cell_points(std::uint32_t cell) const {
-    return &pool_[static_cast<std::size_t>(cell) * max_per_cell_];
-  }
+  // Cell c's coordinates live at pool_[c * 3 * stride_]: x[stride_], y[stride_], z[stride_]
+  // (structure of arrays, so the distance loop of knn runs on SIMD lanes).
+  float* cell_xyz(std::size_t cell) { return &pool_[cell * 3 * stride_]; }
+  const float* cell_xyz(std::size_t cell) const { return &pool_[cell * 3 * stride_]; }
 
   float cell_size_, inv_cell_size_, min_spacing_sq_;
   std::uint32_t max_per_cell_;
+  std::uint32_t stride_;  // max_per_cell_ rounded up to a multiple of 8
   FlatKeyIndex index_;
   std::vector<Cell> cells_;
-  std::vector<Eigen::Vector3f> pool_;  // max_per_cell_ slots per cell
+  std::vector<float> pool_;  // 3 * stride_ floats per cell
   std::size_t num_points_ = 0;
 };
 
