@@ -15,10 +15,18 @@ struct SimulateArgs {
   bool force = false;
   bool quiet = false;
   bool frames_given = false;
+  bool no_traffic = false;
+  bool plain_facades = false;
 };
 
 void run(SimulateArgs& a) {
   auto& cfg = a.config;
+  if (a.no_traffic) cfg.traffic.enabled = false;
+  if (a.plain_facades) cfg.facade_detail = false;
+  if (cfg.traffic.oncoming_per_minute < 0 || cfg.traffic.pedestrians_per_minute < 0 ||
+      cfg.traffic.leader_fraction < 0 || cfg.traffic.leader_fraction > 1 ||
+      cfg.traffic.follower_fraction < 0 || cfg.traffic.follower_fraction > 1)
+    throw scfloam::Error("traffic rates must be >= 0 and the leader/follower fractions within [0, 1]");
   if (!a.replay.empty()) {
     if (cfg.route != "loops" && cfg.route != "kitti")
       throw scfloam::Error("--kitti-poses/--replay replays a trajectory: it cannot be combined with --route " + cfg.route);
@@ -56,6 +64,16 @@ scfloam::cli::RegisterCommand reg("simulate", [](CLI::App& app) {
       ->check(CLI::Range(0.0, 1.0));
   sub->add_option("--dropout", args->config.dropout_prob, "Random dropout probability (default: the sensor's)")
       ->check(CLI::Range(0.0, 0.9));
+  sub->add_flag("--no-traffic", args->no_traffic, "A static world: no moving cars or pedestrians");
+  sub->add_option("--oncoming-per-min", args->config.traffic.oncoming_per_minute, "Oncoming cars passing per minute")
+      ->capture_default_str();
+  sub->add_option("--leader-fraction", args->config.traffic.leader_fraction, "Share of the time a car drives ahead in the ego lane")
+      ->capture_default_str();
+  sub->add_option("--follower-fraction", args->config.traffic.follower_fraction, "Share of the time a car follows in the ego lane")
+      ->capture_default_str();
+  sub->add_option("--pedestrians-per-min", args->config.traffic.pedestrians_per_minute, "Pedestrians appearing per minute")
+      ->capture_default_str();
+  sub->add_flag("--plain-facades", args->plain_facades, "Building walls as plain boxes (no windows, ledges or glass)");
   sub->add_flag("--force", args->force, "Write into a non-empty output directory");
   sub->add_flag("--quiet", args->quiet, "No progress bar");
   sub->callback([args] { run(*args); });

@@ -14,7 +14,8 @@
 namespace scfloam::sim {
 
 Scan render_scan(const World& world, const SensorModel& sensor, const BeamCalibration& calib,
-                 const SweepPoses& poses, std::uint64_t seed, std::uint64_t frame) {
+                 const SweepPoses& poses, std::uint64_t seed, std::uint64_t frame,
+                 const Traffic* traffic, double scan_time_s) {
   const int beams = sensor.beams(), columns = sensor.columns;
   constexpr double kDeg = M_PI / 180.0;
   std::vector<double> sin_el(beams), cos_el(beams), sin_el_true(beams), cos_el_true(beams);
@@ -33,6 +34,7 @@ Scan render_scan(const World& world, const SensorModel& sensor, const BeamCalibr
   const std::uint64_t frame_seed = hash_combine(hash_combine(seed, 0x5CA7ULL), frame);
 
   tbb::parallel_for(tbb::blocked_range<int>(0, columns, 16), [&](const tbb::blocked_range<int>& range) {
+    std::vector<Primitive> movers, column_movers;
     for (int c = range.begin(); c != range.end(); ++c) {
       const double frac = (c + 0.5) / columns;
       // Clockwise from behind the car: azimuth +180 deg -> -180 deg.
@@ -43,6 +45,21 @@ Scan render_scan(const World& world, const SensorModel& sensor, const BeamCalibr
       const Eigen::Vector3d origin = T_world_col.translation();
       const double cos_az = std::cos(az), sin_az = std::sin(az);
       const float time_s = static_cast<float>((frac - 0.5) * sensor.sweep_period_s);
+      // Moving objects where they are when this column fires (a sweep takes 0.1 s whether
+      // or not the ego motion is compensated), kept if they can cross this column's rays.
+      column_movers.clear();
+      if (traffic) {
+        movers.clear();
+        traffic->primitives_at(scan_time_s + time_s, origin.head<2>(), sensor.max_range_m, &movers);
+        const Eigen::Vector3d fwd = T_world_col.linear() * Eigen::Vector3d(cos_az, sin_az, 0);
+        const double col_bearing = std::atan2(fwd.y(), fwd.x());
+        for (const Primitive& p : movers) {
+          const double dx = p.cx - origin.x(), dy = p.cy - origin.y();
+          const double dist = std::hypot(dx, dy), radius = std::hypot(p.hx, p.hy);
+          const double diff = std::abs(std::remainder(std::atan2(dy, dx) - col_bearing, 2 * M_PI));
+          if (dist <= radius + 0.5 || diff < std::asin(radius / dist) + 0.03) column_movers.push_back(p);
+        }
+      }
       for (int b = 0; b < beams; ++b) {
         Rng rng(hash_combine(frame_seed, static_cast<std::uint64_t>(c) * 4096 + b));
         // Direction of the true (miscalibrated) beam: azimuth az + offset.
@@ -51,7 +68,19 @@ Scan render_scan(const World& world, const SensorModel& sensor, const BeamCalibr
         const Eigen::Vector3d dir_true(cos_el_true[b] * cos_true, cos_el_true[b] * sin_true, sin_el_true[b]);
         const Eigen::Vector3d dir_world = T_world_col.linear() * dir_true;
         RayHit hit;
-        if (!world.cast(origin, dir_world, sensor.max_range_m, rng.next(), &hit)) continue;
+        bool found = world.cast(origin, dir_world, sensor.max_range_m, rng.next(), &hit);
+        for (const Primitive& p : column_movers) {
+          double t;
+          Eigen::Vector3d n;
+          if (world.hit_primitive(p, 0, origin, dir_world, found ? hit.range_m : sensor.max_range_m, 0, &t, &n)) {
+            found = true;
+            hit.range_m = t;
+            hit.normal = n;
+            hit.kind = p.kind;
+            hit.reflectance = p.reflectance;
+          }
+        }
+        if (!found) continue;
         const double cos_inc = std::abs(hit.normal.dot(dir_world));
         // Dropouts: random, more at grazing incidence, and weak returns far away.
         double p_drop = sensor.dropout_prob;

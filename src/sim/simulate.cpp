@@ -22,7 +22,8 @@ SensorModel sensor_for(const SimConfig& config) {
   return s;
 }
 
-Scenario build_scenario(const SimConfig& config) {
+namespace {
+Scenario build_world_and_route(const SimConfig& config) {
   const double mount = sensor_for(config).mount_height_m;
   if (config.route == "loops") return make_loops_scenario(config.seed, config.frames, mount);
   if (config.route == "straight") return make_straight_scenario(config.seed, config.frames, mount);
@@ -33,6 +34,13 @@ Scenario build_scenario(const SimConfig& config) {
     return make_replay_scenario(camera_to_lidar_poses(cam, kitti_default_Tr()), config.seed, config.frames, mount);
   }
   throw Error("unknown route `" + config.route + "` (known: loops, straight, kitti)");
+}
+}  // namespace
+
+Scenario build_scenario(const SimConfig& config) {
+  Scenario sc = build_world_and_route(config);
+  sc.world.facade_detail = config.facade_detail;
+  return sc;
 }
 
 PoseList relative_lidar_poses(const Scenario& sc) {
@@ -48,12 +56,13 @@ void simulate_sequence(const SimConfig& config, const fs::path& out_dir, bool pr
   const Scenario sc = build_scenario(config);
   const double world_ms = clock.elapsed_ms();
   const BeamCalibration calib = draw_beam_calibration(sensor, config.seed);
+  const Traffic traffic(sc.trajectory, sc.world, config.traffic, config.seed);
   std::error_code ec;
   fs::create_directories(out_dir / "velodyne", ec);
   if (ec) throw file_error(out_dir, "cannot create the output directory: " + ec.message());
 
   ProgressBar bar("simulate", sc.frames, progress);
-  std::size_t total_points = 0;
+  std::size_t total_points = 0, movers_within_50m = 0;
   for (std::size_t k = 0; k < sc.frames; ++k) {
     SweepPoses poses;
     const double t = k * sc.frame_period_s;
@@ -61,7 +70,9 @@ void simulate_sequence(const SimConfig& config, const fs::path& out_dir, bool pr
     poses.motion_distortion = config.motion_distortion;
     poses.T_world_lidar_start = sc.trajectory.at(t - 0.5 * sensor.sweep_period_s);
     poses.T_world_lidar_end = sc.trajectory.at(t + 0.5 * sensor.sweep_period_s);
-    const Scan scan = render_scan(sc.world, sensor, calib, poses, config.seed, k);
+    const Scan scan = render_scan(sc.world, sensor, calib, poses, config.seed, k,
+                                  config.traffic.enabled ? &traffic : nullptr, t);
+    movers_within_50m += traffic.count_near(t, poses.T_world_lidar.translation().head<2>(), 50);
     total_points += scan.points.size();
     char name[32];
     std::snprintf(name, sizeof name, "%06zu.bin", k);
@@ -102,6 +113,14 @@ void simulate_sequence(const SimConfig& config, const fs::path& out_dir, bool pr
     out << "world:\n  primitives: " << sc.world.primitives.size() << "\n  buildings: " << sc.stats.buildings
         << "\n  trees: " << sc.stats.trees << "\n  poles: " << sc.stats.poles << "\n  cars: " << sc.stats.cars
         << "\n  signs: " << sc.stats.signs << "\n";
+    out << "facade_detail: " << (config.facade_detail ? "true" : "false") << "\n";
+    out << "traffic:\n  enabled: " << (config.traffic.enabled ? "true" : "false")
+        << "\n  oncoming_per_minute: " << config.traffic.oncoming_per_minute
+        << "\n  leader_fraction: " << config.traffic.leader_fraction
+        << "\n  follower_fraction: " << config.traffic.follower_fraction
+        << "\n  pedestrians_per_minute: " << config.traffic.pedestrians_per_minute
+        << "\n  movers: " << traffic.movers().size()
+        << "\n  mean_movers_within_50m: " << (sc.frames ? double(movers_within_50m) / sc.frames : 0.0) << "\n";
     out << "mean_points_per_scan: " << (sc.frames ? total_points / sc.frames : 0) << "\n";
   });
   if (progress)

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 
+#include "scfloam/sim/facade.hpp"
 #include "scfloam/sim/rng.hpp"
 
 namespace scfloam::sim {
@@ -30,6 +31,7 @@ const char* surface_kind_name(SurfaceKind kind) {
     case SurfaceKind::sign: return "sign";
     case SurfaceKind::fence: return "fence";
     case SurfaceKind::wall: return "wall";
+    case SurfaceKind::person: return "person";
   }
   return "unknown";
 }
@@ -403,6 +405,9 @@ bool World::cast(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double max_
     hit->normal = best_normal;
     hit->kind = p.kind;
     hit->reflectance = p.reflectance;
+    if (facade_detail && p.kind == SurfaceKind::building && p.shape == Primitive::Shape::box &&
+        std::abs(best_normal.z()) < 0.5)
+      return refine_facade_hit(p, static_cast<std::uint32_t>(best_index), o, d, ray_seed, facade, hit);
     return true;
   }
   return found;

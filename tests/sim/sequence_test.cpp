@@ -29,6 +29,10 @@ class SimulatedSequence : public ::testing::Test {
     config_->seed = 3;
     config_->frames = 30;
     config_->range_noise_m = 0.01;  // sharper walls make a pose error stand out
+    // A static world of plain walls: what is measured is the ground truth's consistency
+    // (facade detail and traffic are tested in traffic_test / facade tests).
+    config_->traffic.enabled = false;
+    config_->facade_detail = false;
     dir_ = new fs::path(test::scratch_dir("sim_sequence"));
     simulate_sequence(*config_, *dir_, false);
     scenario_ = new Scenario(build_scenario(*config_));

@@ -5,6 +5,7 @@
 #include <cstdint>
 
 #include "scfloam/sim/sensor.hpp"
+#include "scfloam/sim/traffic.hpp"
 #include "scfloam/sim/world.hpp"
 #include "scfloam/types.hpp"
 
@@ -23,7 +24,10 @@ struct SweepPoses {
 // clockwise seen from above, like a Velodyne; point time_s is the column time relative to the
 // scan timestamp (-period/2 .. +period/2). Points are ordered ring by ring (ring 0 = top beam),
 // each ring in firing order. Deterministic in (seed, frame) whatever the thread count.
+// With `traffic`, its movers are placed at scan_time_s + point time (seconds on the
+// trajectory's clock) column by column; without it the scene is the static world.
 Scan render_scan(const World& world, const SensorModel& sensor, const BeamCalibration& calib,
-                 const SweepPoses& poses, std::uint64_t seed, std::uint64_t frame);
+                 const SweepPoses& poses, std::uint64_t seed, std::uint64_t frame,
+                 const Traffic* traffic = nullptr, double scan_time_s = 0);
 
 }  // namespace scfloam::sim

@@ -13,6 +13,7 @@
 
 #include "scfloam/sim/scenario.hpp"
 #include "scfloam/sim/sensor.hpp"
+#include "scfloam/sim/traffic.hpp"
 
 namespace scfloam::sim {
 
@@ -26,6 +27,8 @@ struct SimConfig {
   // Overrides of the preset's noise (negative = keep the preset's value).
   double range_noise_m = -1;
   double dropout_prob = -1;
+  TrafficConfig traffic;  // moving cars and pedestrians (on by default)
+  bool facade_detail = true;  // recessed windows, ledges, glass on building walls
 };
 
 SensorModel sensor_for(const SimConfig& config);

@@ -10,7 +10,7 @@
 namespace scfloam::sim {
 
 enum class SurfaceKind : std::uint8_t {
-  road, sidewalk, curb, building, vegetation, trunk, car, pole, sign, fence, wall
+  road, sidewalk, curb, building, vegetation, trunk, car, pole, sign, fence, wall, person
 };
 const char* surface_kind_name(SurfaceKind kind);
 
@@ -68,6 +68,13 @@ struct RayHit {
   float reflectance = 0;
 };
 
+// Glass in the facade detail (see facade.hpp).
+struct FacadeConfig {
+  double glass_no_return_prob = 0.25;  // a pane gives no return (specular reflection away)
+  double glass_pass_prob = 0.35;       // the ray goes through and returns from the room
+  float glass_reflectance = 0.08f;     // what a pane returns otherwise
+};
+
 class World {
  public:
   // Ground = terrain + curb_height_m where road_edge_distance > 0 (off the road).
@@ -77,6 +84,9 @@ class World {
   // KITTI's HDL-64E reads asphalt at ~0.2-0.35 (median of real scans ~0.3).
   float road_reflectance = 0.28f, sidewalk_reflectance = 0.33f, curb_reflectance = 0.38f;
   std::vector<Primitive> primitives;
+  // Windows, doors, ledges and glass on building walls (facade.hpp); off = plain boxes.
+  bool facade_detail = false;
+  FacadeConfig facade;
 
   // Builds the DDA grid over `primitives`; call after adding them (and before cast()).
   void build_index(double cell_m = 4.0);
@@ -90,12 +100,15 @@ class World {
 
   std::size_t grid_cells() const { return cell_start_.empty() ? 0 : cell_start_.size() - 1; }
 
- private:
-  bool cast_ground(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double t_max,
-                   RayHit* hit) const;
+  // Ray against one primitive (also used for the moving objects, which are not indexed):
+  // entry distance in (0, t_max) and the normal facing the ray.
   bool hit_primitive(const Primitive& p, std::uint32_t index, const Eigen::Vector3d& o,
                      const Eigen::Vector3d& d, double t_max, std::uint64_t ray_seed,
                      double* t, Eigen::Vector3d* normal) const;
+
+ private:
+  bool cast_ground(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double t_max,
+                   RayHit* hit) const;
 
   double grid_x0_ = 0, grid_y0_ = 0, grid_cell_m_ = 4;
   int grid_nx_ = 0, grid_ny_ = 0;
