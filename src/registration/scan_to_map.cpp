@@ -6,6 +6,8 @@
 #include <tbb/task_arena.h>
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
 
 #include "scfloam/error.hpp"
 #include "scfloam/registration/pose_manifold.hpp"
@@ -65,6 +67,20 @@ LocalShape local_shape(const VoxelMap::Neighbors& nb) {
   return s;
 }
 
+// Z-order (Morton) code of p's 1 m cell, 8 bits per axis (wraps beyond +-128 m: it only
+// orders the queries, it never decides a match).
+std::uint64_t morton_cell(const Eigen::Vector3f& p) {
+  auto spread = [](std::uint64_t v) {  // bit i -> bit 3i, for 8 bits
+    v &= 0xff;
+    v = (v | (v << 8)) & 0x00f00full;
+    v = (v | (v << 4)) & 0x0c30c3ull;
+    v = (v | (v << 2)) & 0x249249ull;
+    return v;
+  };
+  auto cell = [](float x) { return static_cast<std::uint64_t>(static_cast<int>(std::floor(x)) + 128); };
+  return spread(cell(p.x())) | (spread(cell(p.y())) << 1) | (spread(cell(p.z())) << 2);
+}
+
 }  // namespace
 
 void ScanToMapRegistration::find_matches(const FeatureCloud& edges, const FeatureCloud& planes,
@@ -82,12 +98,23 @@ void ScanToMapRegistration::find_matches(const FeatureCloud& edges, const Featur
     plane_ok_.assign(planes.size(), 0);
     edge_query_.resize(edges.size());
     plane_query_.resize(planes.size());
+    // Visit the queries in Z-order of their position, edges then planes: neighbouring queries
+    // then read the same map cells and hash slots, which stay in cache (the search is bound by
+    // memory latency, not arithmetic). Results are stored by index, so the order is invisible.
+    query_order_.resize(edges.size() + planes.size());
+    for (std::size_t i = 0; i < edges.size(); ++i)
+      query_order_[i] = (morton_cell(edges[i]) << 32) | i;
+    for (std::size_t j = 0; j < planes.size(); ++j)
+      query_order_[edges.size() + j] = (std::uint64_t{1} << 60) | (morton_cell(planes[j]) << 32) |
+                                       (edges.size() + j);
+    std::sort(query_order_.begin(), query_order_.end());
   }
 
   const std::size_t n_edges = edges.size(), total = edges.size() + planes.size();
   auto work = [&](const tbb::blocked_range<std::size_t>& range) {
     VoxelMap::Neighbors nb;
-    for (std::size_t i = range.begin(); i != range.end(); ++i) {
+    for (std::size_t r = range.begin(); r != range.end(); ++r) {
+      const std::size_t i = query_order_[r] & 0xffffffffu;
       if (i < n_edges) {
         const Eigen::Vector3f q = T * edges[i];
         if (!first_round && (q - edge_query_[i]).squaredNorm() < refresh2) continue;

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <cstdint>
 #include <vector>
 
 #include "scfloam/config.hpp"
@@ -67,6 +68,7 @@ class ScanToMapRegistration {
   std::vector<PlaneMatch> plane_all_, plane_out_;
   std::vector<char> edge_ok_, plane_ok_;
   std::vector<Eigen::Vector3f> edge_query_, plane_query_;  // world position at the last search
+  std::vector<std::uint64_t> query_order_;  // (Z-order cell << 32) | query index, sorted
 };
 
 // One-off convenience: `rounds` correspondence rounds from T_world_lidar_init.
