@@ -39,14 +39,14 @@ void BM_Features(benchmark::State& state, const char* seq) {
   const auto& all = scans(seq);
   const OdometryConfig c;
   FeatureExtractor extractor(c.preprocess, c.rings, c.features);
-  VoxelFilter filter;
+  VoxelFilter edge_filter, plane_filter;
   FeatureCloud edges, planes, e2, p2;
   std::size_t i = 0;
   for (auto _ : state) {
     const Scan& scan = all[i++ % all.size()];
     extractor.extract(scan.points, false, edges, planes);
-    filter.filter(edges, c.features.edge_leaf_m, e2);
-    filter.filter(planes, c.features.plane_leaf_m, p2);
+    edge_filter.filter(edges, c.features.edge_leaf_m, e2);
+    plane_filter.filter(planes, c.features.plane_leaf_m, p2);
     benchmark::DoNotOptimize(p2.data());
   }
   state.counters["edges"] = static_cast<double>(e2.size());

@@ -20,7 +20,7 @@ struct Odometry::Impl {
 
   OdometryConfig config;
   FeatureExtractor extractor;
-  VoxelFilter filter;
+  VoxelFilter edge_filter, plane_filter;  // one each: each sizes its table from its last call
   FeatureMap map;
   ScanToMapRegistration registration;
 
@@ -60,8 +60,8 @@ OdometryResult Odometry::process(const Scan& scan) {
     points = &s.deskewed;
   }
   s.extractor.extract(*points, scan.has_ring && c.rings.use_ring_field, s.raw_edges, s.raw_planes);
-  s.filter.filter(s.raw_edges, c.features.edge_leaf_m, result.edges);
-  s.filter.filter(s.raw_planes, c.features.plane_leaf_m, result.planes);
+  s.edge_filter.filter(s.raw_edges, c.features.edge_leaf_m, result.edges);
+  s.plane_filter.filter(s.raw_planes, c.features.plane_leaf_m, result.planes);
   result.features_ms = watch.elapsed_ms();
   watch.restart();
 

@@ -17,6 +17,7 @@ class VoxelFilter {
  private:
   FlatKeyIndex index_;
   std::vector<Eigen::Vector4f> sums_;  // xyz sum, count
+  std::size_t last_voxels_ = 0;        // voxels of the previous call: sizes the table
 };
 
 // Convenience for one-off use (submaps, tests).
