@@ -56,6 +56,9 @@ FeatureExtractor::FeatureExtractor(const PreprocessConfig& preprocess, const Rin
   candidates_.resize(beams_);
   ring_edges_.resize(beams_);
   ring_planes_.resize(beams_);
+  ring_resorted_.resize(beams_);
+  sort_scratch_.resize(beams_);
+  ring_copy_.resize(beams_);
 }
 
 void FeatureExtractor::assign_rings(const std::vector<LidarPoint>& points, bool use_ring_field) {
@@ -102,13 +105,16 @@ void FeatureExtractor::order_ring_by_azimuth(int ring) {
     const float cross = p[i].x() * p[i + 1].y() - p[i].y() * p[i + 1].x();
     (cross > 0 ? forward : backward) += 1;
   }
+  ring_resorted_[ring] = 0;
   if (std::min(forward, backward) <= n / 50) return;
-  ++stats_.rings_resorted;
-  sort_scratch_.resize(n);
-  for (int i = 0; i < n; ++i) sort_scratch_[i] = {std::atan2(p[i].y(), p[i].x()), i};
-  std::sort(sort_scratch_.begin(), sort_scratch_.end());
-  std::vector<Eigen::Vector3f> copy(p, p + n);
-  for (int i = 0; i < n; ++i) p[i] = copy[sort_scratch_[i].second];
+  ring_resorted_[ring] = 1;
+  auto& order = sort_scratch_[ring];
+  order.resize(n);
+  for (int i = 0; i < n; ++i) order[i] = {std::atan2(p[i].y(), p[i].x()), i};
+  std::sort(order.begin(), order.end());
+  FeatureCloud& copy = ring_copy_[ring];
+  copy.assign(p, p + n);
+  for (int i = 0; i < n; ++i) p[i] = copy[order[i].second];
 }
 
 void FeatureExtractor::select_in_ring(int ring) {
@@ -184,10 +190,14 @@ void FeatureExtractor::extract(const std::vector<LidarPoint>& points, bool use_r
   curvature_.resize(ordered_.size());
   picked_.resize(ordered_.size());
   unreliable_.resize(ordered_.size());
-  for (int r = 0; r < beams_; ++r) order_ring_by_azimuth(r);
+  // Rings are independent: order and select each in parallel (per-ring scratch buffers).
   tbb::parallel_for(tbb::blocked_range<int>(0, beams_, 1), [&](const auto& range) {
-    for (int r = range.begin(); r != range.end(); ++r) select_in_ring(r);
+    for (int r = range.begin(); r != range.end(); ++r) {
+      order_ring_by_azimuth(r);
+      select_in_ring(r);
+    }
   });
+  for (int r = 0; r < beams_; ++r) stats_.rings_resorted += ring_resorted_[r];
   edges.clear();
   planes.clear();
   for (int r = 0; r < beams_; ++r) {

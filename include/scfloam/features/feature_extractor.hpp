@@ -52,7 +52,9 @@ class FeatureExtractor {
   std::vector<char> picked_, unreliable_;
   std::vector<std::vector<int>> candidates_;     // per ring scratch
   std::vector<FeatureCloud> ring_edges_, ring_planes_;
-  std::vector<std::pair<float, int>> sort_scratch_;
+  std::vector<char> ring_resorted_;                            // per ring, last extract()
+  std::vector<std::vector<std::pair<float, int>>> sort_scratch_;  // per ring
+  std::vector<FeatureCloud> ring_copy_;                        // per ring
   FeatureStats stats_;
 };
 
