@@ -64,6 +64,8 @@ scfloam::cli::RegisterCommand reg("simulate", [](CLI::App& app) {
       ->check(CLI::Range(0.0, 1.0));
   sub->add_option("--dropout", args->config.dropout_prob, "Random dropout probability (default: the sensor's)")
       ->check(CLI::Range(0.0, 0.9));
+  sub->add_option("--elevation-bias", args->config.elevation_bias_deg,
+                  "Common elevation error of all beams in degrees (default: the sensor's; hdl64 0.205 as KITTI)");
   sub->add_flag("--no-traffic", args->no_traffic, "A static world: no moving cars or pedestrians");
   sub->add_option("--oncoming-per-min", args->config.traffic.oncoming_per_minute, "Oncoming cars passing per minute")
       ->capture_default_str();

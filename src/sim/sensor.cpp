@@ -28,6 +28,7 @@ SensorModel sensor_preset(const std::string& name) {
     s.elevations_deg.insert(s.elevations_deg.end(), lower.begin(), lower.end());
     s.columns = 2083;  // 0.1728 deg at 10 Hz
     s.max_range_m = 120;
+    s.elevation_bias_deg = 0.205;  // KITTI's published scans
   } else if (name == "vlp16") {
     s.elevations_deg = linear_beams(15.0, -15.0, 16);
     s.columns = 1800;  // 0.2 deg
@@ -55,7 +56,7 @@ BeamCalibration draw_beam_calibration(const SensorModel& sensor, std::uint64_t s
   constexpr double kDeg = M_PI / 180.0;
   BeamCalibration c;
   for (int b = 0; b < sensor.beams(); ++b) {
-    c.elevation_offset_rad.push_back(rng.normal(0, sensor.beam_elevation_error_deg) * kDeg);
+    c.elevation_offset_rad.push_back((rng.normal(0, sensor.beam_elevation_error_deg) + sensor.elevation_bias_deg) * kDeg);
     c.azimuth_offset_rad.push_back(rng.normal(0, sensor.beam_azimuth_error_deg) * kDeg);
     c.range_bias_m.push_back(rng.normal(0, sensor.beam_range_bias_m));
   }

@@ -19,6 +19,7 @@ SensorModel sensor_for(const SimConfig& config) {
   SensorModel s = sensor_preset(config.sensor);
   if (config.range_noise_m >= 0) s.range_noise_m = config.range_noise_m;
   if (config.dropout_prob >= 0) s.dropout_prob = config.dropout_prob;
+  if (config.elevation_bias_deg > -90) s.elevation_bias_deg = config.elevation_bias_deg;
   return s;
 }
 
@@ -109,6 +110,7 @@ void simulate_sequence(const SimConfig& config, const fs::path& out_dir, bool pr
     out << "mount_height_m: " << sensor.mount_height_m << "\n";
     out << "range_noise_m: " << sensor.range_noise_m << "\n";
     out << "dropout_prob: " << sensor.dropout_prob << "\n";
+    out << "elevation_bias_deg: " << sensor.elevation_bias_deg << "\n";
     out << "motion_distortion: " << (config.motion_distortion ? "true" : "false") << "\n";
     out << "world:\n  primitives: " << sc.world.primitives.size() << "\n  buildings: " << sc.stats.buildings
         << "\n  trees: " << sc.stats.trees << "\n  poles: " << sc.stats.poles << "\n  cars: " << sc.stats.cars

@@ -131,3 +131,37 @@ TEST(SensorScan, RingsAreInOrderAndElevationsMatchTheTable) {
 
 }  // namespace
 }  // namespace scfloam::sim
+
+namespace scfloam::sim {
+namespace {
+
+// KITTI's common elevation error: a flat road seen through it bends down with range like a
+// shallow cone (z = -h sin(el) / sin(el + bias)), and without it stays flat.
+TEST(SensorScan, ElevationBiasBendsTheGroundDownWithRange) {
+  SensorModel s = sensor_preset("hdl64");
+  EXPECT_NEAR(s.elevation_bias_deg, 0.205, 1e-12);
+  s.range_noise_m = 0;
+  s.dropout_prob = 0;
+  s.beam_elevation_error_deg = s.beam_azimuth_error_deg = s.beam_range_bias_m = 0;
+  World w = flat_world(100);
+  w.build_index();
+  auto mean_z_at = [&](double bias_deg, double r_lo, double r_hi) {
+    s.elevation_bias_deg = bias_deg;
+    const Scan scan = render_scan(w, s, draw_beam_calibration(s, 1), sensor_at_height(1.73), 1, 0);
+    double sum = 0;
+    int n = 0;
+    for (const auto& p : scan.points) {
+      const double r = std::hypot(p.x, p.y);
+      if (r > r_lo && r < r_hi) sum += p.z, ++n;
+    }
+    EXPECT_GT(n, 100);
+    return sum / n;
+  };
+  EXPECT_NEAR(mean_z_at(0, 19, 21), -1.73, 0.005);
+  // At 20 m the beam is ~4.9 deg down: z = -1.73 * sin(4.9) / sin(4.7) ~ -1.80.
+  EXPECT_NEAR(mean_z_at(0.205, 19, 21), -1.73 - 20 * std::tan(0.205 * M_PI / 180), 0.02);
+  EXPECT_NEAR(mean_z_at(0.205, 4, 6), -1.73 - 5 * std::tan(0.205 * M_PI / 180), 0.01);
+}
+
+}  // namespace
+}  // namespace scfloam::sim

@@ -33,6 +33,7 @@ class SimulatedSequence : public ::testing::Test {
     // (facade detail and traffic are tested in traffic_test / facade tests).
     config_->traffic.enabled = false;
     config_->facade_detail = false;
+    config_->elevation_bias_deg = 0;
     dir_ = new fs::path(test::scratch_dir("sim_sequence"));
     simulate_sequence(*config_, *dir_, false);
     scenario_ = new Scenario(build_scenario(*config_));

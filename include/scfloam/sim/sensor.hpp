@@ -24,6 +24,10 @@ struct SensorModel {
   double beam_elevation_error_deg = 0.02;
   double beam_azimuth_error_deg = 0.02;
   double beam_range_bias_m = 0.008;
+  // A common error of all beams' elevation (true = nominal + bias), as in KITTI's scans,
+  // whose points are commonly corrected by raising them ~0.2 deg (IMLS-SLAM, CT-ICP): the
+  // ground becomes a shallow cone, heights err by range x bias.
+  double elevation_bias_deg = 0;
 
   double azimuth_step_deg() const { return 360.0 / columns; }
   int beams() const { return static_cast<int>(elevations_deg.size()); }

@@ -27,6 +27,7 @@ struct SimConfig {
   // Overrides of the preset's noise (negative = keep the preset's value).
   double range_noise_m = -1;
   double dropout_prob = -1;
+  double elevation_bias_deg = -1e9;  // below -90: keep the preset's (hdl64: KITTI's 0.205)
   TrafficConfig traffic;  // moving cars and pedestrians (on by default)
   bool facade_detail = true;  // recessed windows, ledges, glass on building walls
 };
