@@ -26,10 +26,15 @@ void print_report(const nlohmann::json& summary) {
               summary["frames"].get<std::size_t>(), summary["keyframes"].get<std::size_t>(),
               summary["wall_s"].get<double>(), summary["fps"].get<double>(),
               summary["peak_rss_mb"].get<double>());
-  for (const auto& [stage, t] : summary["timing_ms"].items())
+  for (const auto& [stage, t] : summary["timing_ms"].items()) {
+    if (t["count"].get<std::size_t>() == 0) {
+      std::printf("  %-18s (none)\n", stage.c_str());
+      continue;
+    }
     std::printf("  %-18s median %7.2f ms  mean %7.2f ms  p95 %7.2f ms  (%zu)\n", stage.c_str(),
                 t["median"].get<double>(), t["mean"].get<double>(), t["p95"].get<double>(),
                 t["count"].get<std::size_t>());
+  }
   if (summary.contains("loops")) {
     const auto& l = summary["loops"];
     std::printf("loops: %zu candidates, %zu accepted, %zu rejected\n",
