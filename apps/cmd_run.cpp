@@ -42,14 +42,10 @@ void print_report(const nlohmann::json& summary) {
                 l["rejected"].get<std::size_t>());
   }
   auto accuracy_line = [](const char* name, const nlohmann::json& a) {
-    if (!a["t_err_pct"].is_number()) {
-      std::printf("%-10s t_err n/a (path shorter than 100 m)  ATE %.3f m\n", name,
-                  a["ate_rmse_m"].get<double>());
-      return;
-    }
+    auto number = [](const nlohmann::json& v) { return v.is_number() ? v.get<double>() : NAN; };
     std::printf("%-10s t_err %.3f %%  r_err %.4f deg/100m  ATE %.3f m  (KITTI metric vs ground truth)\n",
-                name, a["t_err_pct"].get<double>(), a["r_err_deg_per_100m"].get<double>(),
-                a["ate_rmse_m"].get<double>());
+                name, number(a["t_err_pct"]), number(a["r_err_deg_per_100m"]),
+                number(a["ate_rmse_m"]));
   };
   if (summary.contains("odometry_accuracy")) accuracy_line("odometry", summary["odometry_accuracy"]);
   if (summary.contains("accuracy")) accuracy_line(summary["mode"].get<std::string>().c_str(), summary["accuracy"]);
