@@ -42,10 +42,14 @@ void print_report(const nlohmann::json& summary) {
                 l["rejected"].get<std::size_t>());
   }
   auto accuracy_line = [](const char* name, const nlohmann::json& a) {
-    auto number = [](const nlohmann::json& v) { return v.is_number() ? v.get<double>() : NAN; };
+    if (!a["t_err_pct"].is_number()) {
+      std::printf("%-10s t_err n/a (path shorter than 100 m)  ATE %.3f m\n", name,
+                  a["ate_rmse_m"].get<double>());
+      return;
+    }
     std::printf("%-10s t_err %.3f %%  r_err %.4f deg/100m  ATE %.3f m  (KITTI metric vs ground truth)\n",
-                name, number(a["t_err_pct"]), number(a["r_err_deg_per_100m"]),
-                number(a["ate_rmse_m"]));
+                name, a["t_err_pct"].get<double>(), a["r_err_deg_per_100m"].get<double>(),
+                a["ate_rmse_m"].get<double>());
   };
   if (summary.contains("odometry_accuracy")) accuracy_line("odometry", summary["odometry_accuracy"]);
   if (summary.contains("accuracy")) accuracy_line(summary["mode"].get<std::string>().c_str(), summary["accuracy"]);
