@@ -74,11 +74,9 @@ void VoxelMap::knn(const Eigen::Vector3f& q, int k, float radius_m, Neighbors& o
       {-1, -1, 0}, {-1, 1, 0},  {1, -1, 0},  {1, 1, 0},   {-1, 0, -1}, {-1, 0, 1}, {1, 0, -1},
       {1, 0, 1},   {0, -1, -1}, {0, -1, 1},  {0, 1, -1},  {0, 1, 1},   {-1, -1, -1},
       {-1, -1, 1}, {-1, 1, -1}, {-1, 1, 1},  {1, -1, -1}, {1, -1, 1},  {1, 1, -1}, {1, 1, 1}};
-  // Squared distances of a block of 8 of a cell's points, computed together, then merged into
-  // the sorted best k; `bound` is the k-th distance once k are found, else r^2. Blocks are
-  // always computed whole (cells are padded to a multiple of 8 slots): the fixed trip count
-  // is what lets -O2 turn the loop into SIMD code.
-  constexpr std::uint32_t kBlock = 8;
+  // Squared distances of a block of a cell's points, computed together (vectorizes), then
+  // merged into the sorted best k; `bound` is the k-th distance once k are found, else r^2.
+  constexpr std::uint32_t kBlock = 32;
   float d2[kBlock];
   float bound = r2;
   for (const auto& o : kOrder) {
@@ -93,7 +91,7 @@ void VoxelMap::knn(const Eigen::Vector3f& q, int k, float radius_m, Neighbors& o
     const std::uint32_t n = cells_[cell].count;
     for (std::uint32_t b = 0; b < n; b += kBlock) {
       const std::uint32_t m = std::min(kBlock, n - b);
-      for (std::uint32_t i = 0; i < kBlock; ++i) {
+      for (std::uint32_t i = 0; i < m; ++i) {
         const float dx = xs[b + i] - q.x(), dy = ys[b + i] - q.y(), dz = zs[b + i] - q.z();
         d2[i] = dx * dx + dy * dy + dz * dz;
       }
