@@ -58,27 +58,6 @@ TrajectoryFormat detect_trajectory_format(const std::filesystem::path& path) {
   throw file_error(path, "no poses in the file");
 }
 
-std::vector<double> read_times(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) throw file_error(path, "cannot open the times file");
-  std::vector<double> stamps;
-  std::string line;
-  std::size_t line_no = 0;
-  while (std::getline(in, line)) {
-    ++line_no;
-    const auto v = parse_numbers(line, path, line_no);
-    if (v.empty()) continue;
-    if (v.size() != 1)
-      throw file_error(path, "line " + std::to_string(line_no) + ": expected one timestamp, found " +
-                                 std::to_string(v.size()) + " numbers");
-    if (!stamps.empty() && v[0] < stamps.back())
-      throw file_error(path, "line " + std::to_string(line_no) + ": timestamps go backwards");
-    stamps.push_back(v[0]);
-  }
-  if (stamps.empty()) throw file_error(path, "no timestamps in the file");
-  return stamps;
-}
-
 LoadedTrajectory load_trajectory(const std::filesystem::path& path, TrajectoryFormat format,
                                  const std::optional<std::filesystem::path>& times_path) {
   LoadedTrajectory t;

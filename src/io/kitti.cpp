@@ -151,16 +151,7 @@ KittiSequence KittiSequence::open(const fs::path& dir) {
 
   const fs::path times = dir / "times.txt";
   if (fs::exists(times)) {
-    std::ifstream in(times);
-    std::string line;
-    std::size_t line_no = 0;
-    while (std::getline(in, line)) {
-      ++line_no;
-      const auto v = parse_numbers(line, times, line_no);
-      if (v.empty()) continue;
-      if (v.size() != 1) throw file_error(times, "line " + std::to_string(line_no) + ": expected one timestamp");
-      seq.times_.push_back(v[0]);
-    }
+    seq.times_ = read_times(times);
     if (seq.times_.size() != seq.scan_paths_.size())
       throw file_error(times, std::to_string(seq.times_.size()) + " timestamps for " +
                                   std::to_string(seq.scan_paths_.size()) + " scans");

@@ -14,26 +14,9 @@
 #include "scfloam/sim/scan.hpp"
 #include "scfloam/sim/scenario.hpp"
 #include "scfloam/sim/sensor.hpp"
+#include "loop/simulated_keyframes.hpp"  // drifting_odometry
 
 using namespace scfloam;
-
-namespace {
-
-// Odometry with a scale error and a steady yaw bias per metre travelled.
-PoseList drifting(const PoseList& gt, double scale_error, double yaw_deg_per_100m) {
-  PoseList out{gt.front()};
-  for (std::size_t k = 1; k < gt.size(); ++k) {
-    Eigen::Isometry3d step = gt[k - 1].inverse() * gt[k];
-    const double travel_m = step.translation().norm();
-    step.translation() *= 1.0 + scale_error;
-    Eigen::Isometry3d bias = Eigen::Isometry3d::Identity();
-    bias.linear() = so3_exp(Eigen::Vector3d(0, 0, yaw_deg_per_100m * M_PI / 180.0 / 100.0 * travel_m));
-    out.push_back(out.back() * step * bias);
-  }
-  return out;
-}
-
-}  // namespace
 
 TEST(LoopClosure, CorrectsADriftingOdometryOnASimulatedDrive) {
   const SlamConfig config;
@@ -44,7 +27,7 @@ TEST(LoopClosure, CorrectsADriftingOdometryOnASimulatedDrive) {
 
   PoseList gt;
   for (std::size_t k = 0; k < scenario.frames; ++k) gt.push_back(scenario.frame_pose(k));
-  const PoseList odometry = drifting(gt, 0.01, 1.0);  // 1 % scale, 1 deg per 100 m
+  const PoseList odometry = test::drifting_odometry(gt, 0.01, 1.0);  // 1 % scale, 1 deg per 100 m
 
   // Keyframes on the odometry, as the pipeline picks them.
   std::vector<std::size_t> frames;

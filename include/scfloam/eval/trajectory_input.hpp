@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "scfloam/io/trajectory.hpp"
 #include "scfloam/types.hpp"
 
 namespace scfloam {
@@ -30,7 +31,6 @@ struct LoadedTrajectory {
 };
 
 // A KITTI times.txt: one timestamp (s) a line, non-decreasing.
-std::vector<double> read_times(const std::filesystem::path& path);
 
 // Reads `path` (format kAuto: detected by content). `times_path`, when given, supplies
 // timestamps for a KITTI file (its count must equal the pose count); a TUM file has its own.

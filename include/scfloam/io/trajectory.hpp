@@ -22,6 +22,9 @@ struct StampedTrajectory {
 StampedTrajectory read_tum(const std::filesystem::path& path);
 void write_tum(const std::filesystem::path& path, const StampedTrajectory& trajectory);
 
+// A times file (KITTI times.txt): one timestamp in seconds a line, never going backwards.
+std::vector<double> read_times(const std::filesystem::path& path);
+
 // The numbers of one text line (space, tab or comma separated), or Error("path: line N: ...").
 std::vector<double> parse_numbers(const std::string& line, const std::filesystem::path& path,
                                   std::size_t line_no);
