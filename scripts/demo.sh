@@ -4,7 +4,7 @@
 #   FRAMES=1500 SEED=7 bash scripts/demo.sh    # a longer drive in another world
 set -euo pipefail
 cd "$(dirname "$0")/.."
-frames="${FRAMES:-1200}"
+frames="${FRAMES:-1000}"
 seed="${SEED:-1}"
 mode="${MODE:-}"
 bash scripts/install-deps.sh
