@@ -57,7 +57,7 @@ for path in sorted(glob.glob(os.path.join(results, "bench_*.json"))):
         if b.get("aggregate_name") != "median":
             continue
         unit = {"ms": 1.0, "us": 1e-3, "ns": 1e-6, "s": 1e3}[b.get("time_unit", "ns")]
-        w(f"| `{b['run_name']}` | {b['real_time'] * unit:.3f} | {b['cpu_time'] * unit:.3f} |")
+        w(f"| `{b['run_name']}` | {b['real_time'] * unit:.4g} | {b['cpu_time'] * unit:.4g} |")
 w("")
 
 w("## Simulator speed (one run each)")
