@@ -87,6 +87,7 @@ std::vector<Binding> bindings(SlamConfig& c) {
   const std::string lr = "loop_registration";
   table.insert(table.end(), {
       {lr, "submap_neighbors", &l.submap_neighbors},
+      {lr, "submap_reuse_keyframes", &l.submap_reuse_keyframes},
       {lr, "coarse_radius_m", &l.coarse_radius_m},
       {lr, "coarse_rounds", &l.coarse_rounds},
       {lr, "rounds", &l.rounds},

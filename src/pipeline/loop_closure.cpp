@@ -1,5 +1,7 @@
 #include "pipeline/loop_closure.hpp"
 
+#include <cstdlib>
+
 #include "scfloam/stats.hpp"
 
 namespace scfloam {
@@ -22,6 +24,24 @@ std::vector<KeyframeView> LoopClosure::submap_around(std::size_t loop_kf, std::s
   return submap;
 }
 
+LoopMatch LoopClosure::register_features(const KeyframeView& current, std::size_t loop_kf,
+                                         std::size_t limit, double sc_yaw_rad) {
+  const int reuse = config_.loop_registration.submap_reuse_keyframes;
+  const bool reusable =
+      submap_ && reuse > 0 &&
+      std::abs(static_cast<long>(loop_kf) - static_cast<long>(submap_->anchor_keyframe())) <= reuse;
+  if (!reusable) {
+    std::size_t loop_index = 0;
+    const std::vector<KeyframeView> views = submap_around(loop_kf, limit, loop_index);
+    submap_ = std::make_unique<LoopSubmap>(views, loop_index, views.empty() ? 0 : loop_kf - loop_index,
+                                           config_.loop_registration,
+                                           config_.odometry.registration, config_.odometry.map);
+  }
+  return register_loop_features(current, *submap_, graph_.pose(submap_->anchor_keyframe()),
+                                graph_.pose(loop_kf), sc_yaw_rad, config_.loop_registration,
+                                config_.odometry.registration);
+}
+
 bool LoopClosure::add(const KeyframePtr& keyframe, const LoopQuery& query) {
   const std::size_t k = keyframe->index;
   graph_.add_node(store_.current_pose(k));
@@ -32,17 +52,17 @@ bool LoopClosure::add(const KeyframePtr& keyframe, const LoopQuery& query) {
   // Register the current keyframe to the loop keyframe's submap, at the current estimates.
   Stopwatch watch;
   const std::size_t loop_kf = static_cast<std::size_t>(query.best->loop_kf);
-  std::size_t loop_index = 0;
-  // The submap stops short of the recent keyframes, which are never loop partners.
-  const std::vector<KeyframeView> submap = submap_around(loop_kf, k, loop_index);
   const KeyframeView current{graph_.pose(k), &keyframe->edges, &keyframe->planes, &keyframe->raw};
-  const LoopMatch match =
-      method_ == LoopRegistrationMethod::kFeatures
-          ? register_loop_features(current, submap, loop_index, query.best->yaw_rad,
-                                   config_.loop_registration, config_.odometry.registration,
-                                   config_.odometry.map)
-          : register_loop_icp(current, submap, loop_index, query.best->yaw_rad,
+  // The submap stops short of the recent keyframes, which are never loop partners.
+  LoopMatch match;
+  if (method_ == LoopRegistrationMethod::kFeatures) {
+    match = register_features(current, loop_kf, k, query.best->yaw_rad);
+  } else {
+    std::size_t loop_index = 0;
+    const std::vector<KeyframeView> submap = submap_around(loop_kf, k, loop_index);
+    match = register_loop_icp(current, submap, loop_index, query.best->yaw_rad,
                               config_.loop_registration);
+  }
   registration_ms_.push_back(watch.elapsed_ms());
   log_.set_match(*row, match.accepted ? LoopVerdict::kAccepted : LoopVerdict::kRejectedMatch,
                  match.inlier_fraction, match.residual_m);

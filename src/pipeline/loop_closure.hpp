@@ -4,6 +4,7 @@
 #pragma once
 
 #include <atomic>
+#include <memory>
 #include <vector>
 
 #include "pipeline/keyframe_store.hpp"
@@ -34,12 +35,15 @@ class LoopClosure {
  private:
   std::vector<KeyframeView> submap_around(std::size_t loop_kf, std::size_t limit,
                                           std::size_t& loop_index) const;
+  LoopMatch register_features(const KeyframeView& current, std::size_t loop_kf, std::size_t limit,
+                              double sc_yaw_rad);
 
   const SlamConfig& config_;
   LoopRegistrationMethod method_;
   KeyframeStore& store_;
   PoseGraph graph_;
   LoopLog log_;
+  std::unique_ptr<LoopSubmap> submap_;  // feature method: reused across consecutive loops
   std::vector<std::size_t> loop_rows_;  // loops.csv row of each loop edge, in edge order
   std::atomic<std::size_t> accepted_{0};
   std::vector<double> registration_ms_, optimization_ms_;

@@ -10,6 +10,7 @@
 
 #include "scfloam/config.hpp"
 #include "scfloam/loop/loop_registration_config.hpp"
+#include "scfloam/registration/scan_to_map.hpp"
 #include "scfloam/types.hpp"
 
 namespace scfloam {
@@ -36,8 +37,36 @@ std::vector<Eigen::Isometry3d> loop_initial_guesses(const Eigen::Isometry3d& T_w
                                                     const Eigen::Isometry3d& T_world_current,
                                                     double sc_yaw_rad);
 
-// The paper's method. `submap` holds the loop keyframe and its neighbours; `loop_index` says
-// which of them is the loop keyframe.
+// The feature maps of a submap (coarse and fine), in the frame of its anchor keyframe. Building
+// it costs more than registering to it (about 127 vs 38 ms for 51 keyframes), and consecutive
+// loop frames revisit neighbouring keyframes, so the loop stage keeps one and reuses it.
+class LoopSubmap {
+ public:
+  // `keyframes` are keyframes first_keyframe, first_keyframe + 1, ...; `anchor` indexes them.
+  LoopSubmap(const std::vector<KeyframeView>& keyframes, std::size_t anchor,
+             std::size_t first_keyframe, const LoopRegistrationConfig& config,
+             const RegistrationConfig& registration, const LocalMapConfig& map_config);
+  std::size_t first_keyframe() const { return first_; }
+  std::size_t last_keyframe() const { return last_; }
+  std::size_t anchor_keyframe() const { return anchor_; }
+  const FeatureMap& coarse() const { return coarse_; }
+  const FeatureMap& fine() const { return fine_; }
+
+ private:
+  std::size_t first_, last_, anchor_;
+  FeatureMap coarse_, fine_;
+};
+
+// The paper's method on a prepared submap: `T_world_anchor` and `T_world_loop` are the current
+// estimates of the submap's anchor keyframe and of the loop keyframe (often the same one).
+LoopMatch register_loop_features(const KeyframeView& current, const LoopSubmap& submap,
+                                 const Eigen::Isometry3d& T_world_anchor,
+                                 const Eigen::Isometry3d& T_world_loop, double sc_yaw_rad,
+                                 const LoopRegistrationConfig& config,
+                                 const RegistrationConfig& registration);
+
+// The paper's method, building the submap: `submap` holds the loop keyframe and its
+// neighbours; `loop_index` says which of them is the loop keyframe.
 LoopMatch register_loop_features(const KeyframeView& current, const std::vector<KeyframeView>& submap,
                                  std::size_t loop_index, double sc_yaw_rad,
                                  const LoopRegistrationConfig& config,

@@ -5,6 +5,9 @@ namespace scfloam {
 
 struct LoopRegistrationConfig {
   int submap_neighbors = 25;  // keyframes each side of the loop keyframe in the submap
+  // Reuse the last submap while the loop keyframe stays within this many keyframes of its
+  // anchor (consecutive loop frames revisit neighbouring keyframes); 0 rebuilds every time.
+  int submap_reuse_keyframes = 10;
   // Feature registration, coarse to fine: a loop starts farther off than a frame does, so the
   // first rounds search correspondences within coarse_radius_m, the last ones within the
   // odometry's own radius.
