@@ -1,6 +1,7 @@
 // Whole sequences: the KITTI convention round trip, ground-truth consistency of the scans
 // (a wall accumulated over many frames stays as thin as the noise), and determinism.
 #include <gtest/gtest.h>
+#include <unistd.h>
 #include <tbb/global_control.h>
 
 #include <Eigen/Eigenvalues>
@@ -34,12 +35,14 @@ class SimulatedSequence : public ::testing::Test {
     config_->traffic.enabled = false;
     config_->facade_detail = false;
     config_->elevation_bias_deg = 0;
-    dir_ = new fs::path(test::scratch_dir("sim_sequence"));
+    // One folder per process: ctest runs this suite's tests as parallel processes.
+    dir_ = new fs::path(test::scratch_dir("sim_sequence-" + std::to_string(::getpid())));
     simulate_sequence(*config_, *dir_, false);
     scenario_ = new Scenario(build_scenario(*config_));
   }
   static void TearDownTestSuite() {
     delete config_;
+    fs::remove_all(*dir_);
     delete dir_;
     delete scenario_;
   }
