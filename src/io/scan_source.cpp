@@ -30,7 +30,8 @@ class KittiScanSource final : public ScanSource {
 
 }  // namespace
 
-std::unique_ptr<ScanSource> open_scan_source(const std::filesystem::path& path) {
+std::unique_ptr<ScanSource> open_scan_source(const std::filesystem::path& path,
+                                             const ScanSourceOptions& /*options*/) {
   namespace fs = std::filesystem;
   if (!fs::exists(path)) throw file_error(path, "no such file or directory");
   if (fs::is_directory(path) && fs::is_directory(path / "velodyne"))

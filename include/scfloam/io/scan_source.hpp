@@ -26,7 +26,14 @@ class ScanSource {
   virtual PoseList ground_truth_lidar() const { return {}; }
 };
 
+// How to read an input whose kind leaves choices open.
+struct ScanSourceOptions {
+  std::string topic;                        // bags: the PointCloud2 topic (auto when empty)
+  std::filesystem::path timestamps_file;    // folders: one stamp per scan (else from names/headers)
+};
+
 // Detects the kind of input at `path` and opens it; Error naming the path when it cannot.
-std::unique_ptr<ScanSource> open_scan_source(const std::filesystem::path& path);
+std::unique_ptr<ScanSource> open_scan_source(const std::filesystem::path& path,
+                                             const ScanSourceOptions& options = {});
 
 }  // namespace scfloam
