@@ -299,6 +299,10 @@ RunResult run_slam(const ScanSource& source, const SlamConfig& base_config,
     std::snprintf(note, sizeof note, "%.1f ms/frame, %zu loops", f.back() + r.back(),
                   closure.accepted_loops());
     progress.update(index + 1, note);
+    if (options.stop && options.stop->load() && index + 1 < count) {
+      result.interrupted = true;
+      break;
+    }
   }
   if (threads) threads->finish();
   progress.finish();

@@ -1,6 +1,7 @@
 // The single entry point that knows the whole order of the stages: scans in, trajectory out.
 #pragma once
 
+#include <atomic>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -30,6 +31,9 @@ struct RunOptions {
   std::size_t max_frames = 0;  // 0: every scan of the source
   bool progress = true;        // progress bar on stderr
   bool deterministic = false;  // loop work in frame order on one thread (also a config key)
+  // Set from elsewhere (a signal handler) to stop early: checked between frames; the loop work
+  // already queued is finished, so the result is a complete run over the frames processed.
+  const std::atomic<bool>* stop = nullptr;
 };
 
 class PoseGraph;
@@ -44,6 +48,7 @@ struct RunResult {
   // Per-stage samples in milliseconds ("features", "registration", ...).
   std::map<std::string, std::vector<double>> timing_ms;
   double wall_s = 0;
+  bool interrupted = false;  // RunOptions::stop ended the run before the last scan
   // Loop modes only: every loop candidate with its verdict, the final graph, the keyframes
   // with their final poses.
   std::vector<LoopCandidate> loop_rows;
