@@ -1,8 +1,11 @@
 // `scfloam run INPUT`: the whole system on a recorded sequence.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 
 #include "command_registry.hpp"
+#include "interrupt.hpp"
 #include "scfloam/error.hpp"
 #include "scfloam/pipeline/outputs.hpp"
 #include "scfloam/pipeline/pipeline.hpp"
@@ -72,11 +75,20 @@ void run(const RunArgs& args) {
   options.max_frames = args.frames;
   options.progress = !args.quiet;
   options.deterministic = args.deterministic;
+  options.stop = &install_interrupt_handlers();
   const RunResult result = run_slam(*source, config, options);
-  const nlohmann::json summary = make_summary(*source, result);
+  nlohmann::json summary = make_summary(*source, result);
+  summary["interrupted"] = result.interrupted;
   write_run_outputs(out_dir, *source, result, summary);
   print_report(summary);
   std::printf("results in %s\n", out_dir.string().c_str());
+  if (result.interrupted) {
+    // The results of the frames processed are complete; the exit code says they are not all.
+    std::printf("interrupted after %zu of %zu frames\n", result.T_world_lidar.size(),
+                args.frames ? std::min(args.frames, source->size()) : source->size());
+    std::fflush(stdout);
+    std::exit(128 + interrupt_signal());
+  }
 }
 
 RegisterCommand reg("run", [](CLI::App& app) {
