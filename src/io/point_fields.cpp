@@ -1,0 +1,206 @@
+#include "scfloam/io/point_fields.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstring>
+
+#include "scfloam/error.hpp"
+
+namespace scfloam {
+namespace {
+
+std::string lower(std::string s) {
+  for (auto& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+template <typename T>
+T load_as(const unsigned char* p, bool swap) {
+  unsigned char bytes[sizeof(T)];
+  std::memcpy(bytes, p, sizeof(T));
+  if (swap) std::reverse(bytes, bytes + sizeof(T));
+  T v;
+  std::memcpy(&v, bytes, sizeof(T));
+  return v;
+}
+
+double read_value(const unsigned char* p, FieldType type, bool swap) {
+  switch (type) {
+    case FieldType::kInt8: return load_as<std::int8_t>(p, false);
+    case FieldType::kUint8: return load_as<std::uint8_t>(p, false);
+    case FieldType::kInt16: return load_as<std::int16_t>(p, swap);
+    case FieldType::kUint16: return load_as<std::uint16_t>(p, swap);
+    case FieldType::kInt32: return load_as<std::int32_t>(p, swap);
+    case FieldType::kUint32: return load_as<std::uint32_t>(p, swap);
+    case FieldType::kFloat32: return load_as<float>(p, swap);
+    case FieldType::kFloat64: return load_as<double>(p, swap);
+  }
+  return 0;
+}
+
+bool host_is_big_endian() {
+  const std::uint16_t one = 1;
+  unsigned char first;
+  std::memcpy(&first, &one, 1);
+  return first == 0;
+}
+
+}  // namespace
+
+std::size_t field_type_size(FieldType type) {
+  switch (type) {
+    case FieldType::kInt8:
+    case FieldType::kUint8: return 1;
+    case FieldType::kInt16:
+    case FieldType::kUint16: return 2;
+    case FieldType::kInt32:
+    case FieldType::kUint32:
+    case FieldType::kFloat32: return 4;
+    case FieldType::kFloat64: return 8;
+  }
+  return 0;
+}
+
+const char* field_type_name(FieldType type) {
+  switch (type) {
+    case FieldType::kInt8: return "int8";
+    case FieldType::kUint8: return "uint8";
+    case FieldType::kInt16: return "int16";
+    case FieldType::kUint16: return "uint16";
+    case FieldType::kInt32: return "int32";
+    case FieldType::kUint32: return "uint32";
+    case FieldType::kFloat32: return "float32";
+    case FieldType::kFloat64: return "float64";
+  }
+  return "?";
+}
+
+std::optional<FieldType> field_type_from_pcd(char type, std::size_t size) {
+  switch (std::toupper(static_cast<unsigned char>(type))) {
+    case 'F':
+      if (size == 4) return FieldType::kFloat32;
+      if (size == 8) return FieldType::kFloat64;
+      break;
+    case 'I':
+      if (size == 1) return FieldType::kInt8;
+      if (size == 2) return FieldType::kInt16;
+      if (size == 4) return FieldType::kInt32;
+      break;
+    case 'U':
+      if (size == 1) return FieldType::kUint8;
+      if (size == 2) return FieldType::kUint16;
+      if (size == 4) return FieldType::kUint32;
+      break;
+  }
+  return std::nullopt;
+}
+
+std::optional<FieldType> field_type_from_ply(const std::string& name) {
+  const std::string n = lower(name);
+  if (n == "char" || n == "int8") return FieldType::kInt8;
+  if (n == "uchar" || n == "uint8") return FieldType::kUint8;
+  if (n == "short" || n == "int16") return FieldType::kInt16;
+  if (n == "ushort" || n == "uint16") return FieldType::kUint16;
+  if (n == "int" || n == "int32") return FieldType::kInt32;
+  if (n == "uint" || n == "uint32") return FieldType::kUint32;
+  if (n == "float" || n == "float32") return FieldType::kFloat32;
+  if (n == "double" || n == "float64") return FieldType::kFloat64;
+  return std::nullopt;
+}
+
+PointLayout map_point_fields(const std::vector<PointField>& fields) {
+  PointLayout layout;
+  auto claim = [](int& slot, int index) {
+    if (slot < 0) slot = index;  // the first field of a role wins
+  };
+  for (int i = 0; i < static_cast<int>(fields.size()); ++i) {
+    const std::string n = lower(fields[i].name);
+    if (n == "x") claim(layout.x, i);
+    else if (n == "y") claim(layout.y, i);
+    else if (n == "z") claim(layout.z, i);
+    else if (n == "intensity" || n == "reflectivity" || n == "reflectance" || n == "i")
+      claim(layout.intensity, i);
+    else if (n == "ring" || n == "channel" || n == "laser_id" || n == "line")
+      claim(layout.ring, i);
+    else if (n == "time" || n == "t" || n == "timestamp" || n == "time_offset" ||
+             n == "offset_time" || n == "time_stamp")
+      claim(layout.time, i);
+  }
+  if (layout.x < 0 || layout.y < 0 || layout.z < 0) {
+    std::string names;
+    for (const auto& f : fields) names += (names.empty() ? "" : " ") + f.name;
+    throw Error("points have no x, y and z fields (fields: " + (names.empty() ? "none" : names) + ")");
+  }
+  return layout;
+}
+
+TimeEncoding time_encoding(FieldType type, double first_value) {
+  if (type == FieldType::kFloat32) return TimeEncoding::kRelativeSeconds;
+  if (type == FieldType::kFloat64)
+    return std::abs(first_value) >= 1e6 ? TimeEncoding::kAbsoluteSeconds : TimeEncoding::kRelativeSeconds;
+  return TimeEncoding::kRelativeNanoseconds;
+}
+
+void append_points(const unsigned char* data, std::size_t count, std::size_t stride,
+                   const std::vector<PointField>& fields, const PointLayout& layout,
+                   bool big_endian, Scan& scan) {
+  const bool swap = big_endian != host_is_big_endian();
+  const PointField& fx = fields.at(layout.x);
+  const PointField& fy = fields.at(layout.y);
+  const PointField& fz = fields.at(layout.z);
+  const PointField* fi = layout.intensity >= 0 ? &fields[layout.intensity] : nullptr;
+  const PointField* fr = layout.ring >= 0 ? &fields[layout.ring] : nullptr;
+  const PointField* ft = layout.time >= 0 ? &fields[layout.time] : nullptr;
+  bool time_decided = false;
+  TimeEncoding encoding = TimeEncoding::kRelativeSeconds;
+  double time_origin_s = 0;
+  scan.points.reserve(scan.points.size() + count);
+  for (std::size_t i = 0; i < count; ++i) {
+    const unsigned char* p = data + i * stride;
+    LidarPoint q;
+    const double x = read_value(p + fx.offset, fx.type, swap);
+    const double y = read_value(p + fy.offset, fy.type, swap);
+    const double z = read_value(p + fz.offset, fz.type, swap);
+    if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) continue;
+    q.x = static_cast<float>(x);
+    q.y = static_cast<float>(y);
+    q.z = static_cast<float>(z);
+    if (fi) {
+      const double v = read_value(p + fi->offset, fi->type, swap);
+      q.intensity = std::isfinite(v) ? static_cast<float>(v) : 0.f;
+    }
+    if (fr) q.ring = static_cast<std::int16_t>(std::clamp(read_value(p + fr->offset, fr->type, swap), -1.0, 32767.0));
+    if (ft) {
+      const double raw = read_value(p + ft->offset, ft->type, swap);
+      if (!time_decided) {
+        encoding = time_encoding(ft->type, raw);
+        if (encoding == TimeEncoding::kAbsoluteSeconds) {
+          if (scan.timestamp_s == 0) scan.timestamp_s = raw;  // no header stamp: the first point's
+          time_origin_s = scan.timestamp_s;
+        }
+        time_decided = true;
+      }
+      switch (encoding) {
+        case TimeEncoding::kRelativeSeconds: q.time_s = static_cast<float>(raw); break;
+        case TimeEncoding::kRelativeNanoseconds: q.time_s = static_cast<float>(raw * 1e-9); break;
+        case TimeEncoding::kAbsoluteSeconds: q.time_s = static_cast<float>(raw - time_origin_s); break;
+      }
+    }
+    scan.points.push_back(q);
+  }
+  scan.has_ring = fr != nullptr;
+  scan.has_time = ft != nullptr;
+}
+
+std::vector<std::string> describe_fields(const std::vector<PointField>& fields) {
+  std::vector<std::string> out;
+  for (const auto& f : fields) {
+    std::string s = f.name + ":" + field_type_name(f.type);
+    if (f.count > 1) s += "[" + std::to_string(f.count) + "]";
+    out.push_back(s);
+  }
+  return out;
+}
+
+}  // namespace scfloam
