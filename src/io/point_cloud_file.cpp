@@ -1,26 +1,42 @@
 #include "scfloam/io/point_cloud_file.hpp"
 
-#include <string>
+#include <algorithm>
+#include <cctype>
+#include <fstream>
+#include <iterator>
 
-#include "scfloam/atomic_file.hpp"
+#include "scfloam/error.hpp"
+#include "scfloam/io/kitti.hpp"
 
 namespace scfloam {
 
+std::string read_file_bytes(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw file_error(path, "cannot open for reading");
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) throw file_error(path, "read error");
+  return bytes;
+}
+
+PointCloudFile read_point_cloud_file(const std::filesystem::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  if (ext == ".pcd") return read_pcd(path);
+  if (ext == ".ply") return read_ply(path);
+  if (ext == ".bin") {
+    PointCloudFile file;
+    file.scan.points = read_kitti_bin(path);
+    file.format = "KITTI .bin";
+    file.declared_points = file.scan.points.size();
+    file.fields = {{"x", 0, FieldType::kFloat32}, {"y", 4, FieldType::kFloat32},
+                   {"z", 8, FieldType::kFloat32}, {"reflectance", 12, FieldType::kFloat32}};
+    return file;
+  }
+  throw file_error(path, "not a point-cloud file (expected .pcd, .ply or .bin)");
+}
+
 void write_pcd_binary(const std::filesystem::path& path, const std::vector<LidarPoint>& points) {
-  write_file_atomic(path, [&](std::ostream& out) {
-    out << "# .PCD v0.7 - Point Cloud Data file format (written by scfloam)\n"
-        << "VERSION 0.7\nFIELDS x y z intensity\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 1\n"
-        << "WIDTH " << points.size() << "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\n"
-        << "POINTS " << points.size() << "\nDATA binary\n";
-    std::vector<float> row(4 * points.size());
-    for (std::size_t i = 0; i < points.size(); ++i) {
-      row[4 * i + 0] = points[i].x;
-      row[4 * i + 1] = points[i].y;
-      row[4 * i + 2] = points[i].z;
-      row[4 * i + 3] = points[i].intensity;
-    }
-    out.write(reinterpret_cast<const char*>(row.data()), row.size() * sizeof(float));
-  });
+  write_pcd(path, points, PcdEncoding::kBinary);
 }
 
 }  // namespace scfloam

@@ -204,3 +204,29 @@ std::vector<std::string> describe_fields(const std::vector<PointField>& fields) 
 }
 
 }  // namespace scfloam
+
+namespace scfloam {
+namespace {
+template <typename T>
+void store_as(unsigned char* dst, double v) {
+  const T t = static_cast<T>(v);
+  std::memcpy(dst, &t, sizeof(T));
+}
+}  // namespace
+
+void store_field_value(unsigned char* dst, FieldType type, double value) {
+  // Integers: NaN and out-of-range values would be undefined behaviour in the cast.
+  auto clamp_int = [&](double lo, double hi) { return std::isfinite(value) ? std::clamp(value, lo, hi) : 0.0; };
+  switch (type) {
+    case FieldType::kInt8: store_as<std::int8_t>(dst, clamp_int(-128, 127)); break;
+    case FieldType::kUint8: store_as<std::uint8_t>(dst, clamp_int(0, 255)); break;
+    case FieldType::kInt16: store_as<std::int16_t>(dst, clamp_int(-32768, 32767)); break;
+    case FieldType::kUint16: store_as<std::uint16_t>(dst, clamp_int(0, 65535)); break;
+    case FieldType::kInt32: store_as<std::int32_t>(dst, clamp_int(-2147483648.0, 2147483647.0)); break;
+    case FieldType::kUint32: store_as<std::uint32_t>(dst, clamp_int(0, 4294967295.0)); break;
+    case FieldType::kFloat32: store_as<float>(dst, value); break;
+    case FieldType::kFloat64: store_as<double>(dst, value); break;
+  }
+}
+
+}  // namespace scfloam

@@ -56,3 +56,8 @@ void append_points(const unsigned char* data, std::size_t count, std::size_t str
 std::vector<std::string> describe_fields(const std::vector<PointField>& fields);
 
 }  // namespace scfloam
+
+namespace scfloam {
+// Writes `value` as `type` in native byte order at `dst` (ASCII readers pack their rows with it).
+void store_field_value(unsigned char* dst, FieldType type, double value);
+}  // namespace scfloam
