@@ -11,7 +11,7 @@ namespace scfloam {
 namespace {
 
 struct PcdHeader {
-  std::vector<PointField> fields;
+  std::vector<CloudField> fields;
   std::size_t point_step = 0;
   std::size_t width = 0, height = 1, points = 0;
   std::string data;          // ascii | binary | binary_compressed
@@ -78,7 +78,7 @@ PcdHeader parse_header(const std::filesystem::path& path, const std::string& byt
     const std::size_t size = parse_count(path, "SIZE", sizes[i]);
     const auto type = field_type_from_pcd(types[i].size() == 1 ? types[i][0] : '?', size);
     if (!type) throw file_error(path, "PCD field `" + names[i] + "`: TYPE " + types[i] + " SIZE " + sizes[i] + " is not a number type");
-    PointField f{names[i], h.point_step, *type, counts.empty() ? 1 : parse_count(path, "COUNT", counts[i])};
+    CloudField f{names[i], h.point_step, *type, counts.empty() ? 1 : parse_count(path, "COUNT", counts[i])};
     if (f.count == 0) throw file_error(path, "PCD field `" + names[i] + "` has COUNT 0");
     h.point_step += size * f.count;
     h.fields.push_back(f);
@@ -164,7 +164,7 @@ PointCloudFile read_pcd(const std::filesystem::path& path) {
 
 void write_pcd(const std::filesystem::path& path, const std::vector<LidarPoint>& points,
                PcdEncoding encoding, bool with_ring_time) {
-  std::vector<PointField> fields = {{"x", 0, FieldType::kFloat32}, {"y", 4, FieldType::kFloat32},
+  std::vector<CloudField> fields = {{"x", 0, FieldType::kFloat32}, {"y", 4, FieldType::kFloat32},
                                     {"z", 8, FieldType::kFloat32}, {"intensity", 12, FieldType::kFloat32}};
   if (with_ring_time) {
     fields.push_back({"ring", 16, FieldType::kUint16});

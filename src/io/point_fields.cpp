@@ -4,6 +4,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstring>
+#include <initializer_list>
 
 #include "scfloam/error.hpp"
 
@@ -109,24 +110,22 @@ std::optional<FieldType> field_type_from_ply(const std::string& name) {
   return std::nullopt;
 }
 
-PointLayout map_point_fields(const std::vector<PointField>& fields) {
-  PointLayout layout;
-  auto claim = [](int& slot, int index) {
-    if (slot < 0) slot = index;  // the first field of a role wins
+PointLayout map_point_fields(const std::vector<CloudField>& fields) {
+  // The first name of each list that is present wins (intensity before reflectivity, ...):
+  // the same names and preference as the PointCloud2 conversion of the bag readers.
+  auto find = [&](std::initializer_list<const char*> names) {
+    for (const char* name : names)
+      for (int i = 0; i < static_cast<int>(fields.size()); ++i)
+        if (lower(fields[i].name) == name) return i;
+    return -1;
   };
-  for (int i = 0; i < static_cast<int>(fields.size()); ++i) {
-    const std::string n = lower(fields[i].name);
-    if (n == "x") claim(layout.x, i);
-    else if (n == "y") claim(layout.y, i);
-    else if (n == "z") claim(layout.z, i);
-    else if (n == "intensity" || n == "reflectivity" || n == "reflectance" || n == "i")
-      claim(layout.intensity, i);
-    else if (n == "ring" || n == "channel" || n == "laser_id" || n == "line")
-      claim(layout.ring, i);
-    else if (n == "time" || n == "t" || n == "timestamp" || n == "time_offset" ||
-             n == "offset_time" || n == "time_stamp")
-      claim(layout.time, i);
-  }
+  PointLayout layout;
+  layout.x = find({"x"});
+  layout.y = find({"y"});
+  layout.z = find({"z"});
+  layout.intensity = find({"intensity", "reflectivity", "reflectance", "i"});
+  layout.ring = find({"ring", "channel"});
+  layout.time = find({"time", "t", "time_offset", "offset_time", "timestamp", "ts"});
   if (layout.x < 0 || layout.y < 0 || layout.z < 0) {
     std::string names;
     for (const auto& f : fields) names += (names.empty() ? "" : " ") + f.name;
@@ -136,22 +135,21 @@ PointLayout map_point_fields(const std::vector<PointField>& fields) {
 }
 
 TimeEncoding time_encoding(FieldType type, double first_value) {
-  if (type == FieldType::kFloat32) return TimeEncoding::kRelativeSeconds;
-  if (type == FieldType::kFloat64)
-    return std::abs(first_value) >= 1e6 ? TimeEncoding::kAbsoluteSeconds : TimeEncoding::kRelativeSeconds;
+  if (type == FieldType::kFloat32 || type == FieldType::kFloat64)
+    return std::abs(first_value) > 1e6 ? TimeEncoding::kAbsoluteSeconds : TimeEncoding::kRelativeSeconds;
   return TimeEncoding::kRelativeNanoseconds;
 }
 
 void append_points(const unsigned char* data, std::size_t count, std::size_t stride,
-                   const std::vector<PointField>& fields, const PointLayout& layout,
+                   const std::vector<CloudField>& fields, const PointLayout& layout,
                    bool big_endian, Scan& scan) {
   const bool swap = big_endian != host_is_big_endian();
-  const PointField& fx = fields.at(layout.x);
-  const PointField& fy = fields.at(layout.y);
-  const PointField& fz = fields.at(layout.z);
-  const PointField* fi = layout.intensity >= 0 ? &fields[layout.intensity] : nullptr;
-  const PointField* fr = layout.ring >= 0 ? &fields[layout.ring] : nullptr;
-  const PointField* ft = layout.time >= 0 ? &fields[layout.time] : nullptr;
+  const CloudField& fx = fields.at(layout.x);
+  const CloudField& fy = fields.at(layout.y);
+  const CloudField& fz = fields.at(layout.z);
+  const CloudField* fi = layout.intensity >= 0 ? &fields[layout.intensity] : nullptr;
+  const CloudField* fr = layout.ring >= 0 ? &fields[layout.ring] : nullptr;
+  const CloudField* ft = layout.time >= 0 ? &fields[layout.time] : nullptr;
   bool time_decided = false;
   TimeEncoding encoding = TimeEncoding::kRelativeSeconds;
   double time_origin_s = 0;
@@ -173,7 +171,7 @@ void append_points(const unsigned char* data, std::size_t count, std::size_t str
     if (fr) q.ring = static_cast<std::int16_t>(std::clamp(read_value(p + fr->offset, fr->type, swap), -1.0, 32767.0));
     if (ft) {
       const double raw = read_value(p + ft->offset, ft->type, swap);
-      if (!time_decided) {
+      if (!time_decided && std::isfinite(raw)) {
         encoding = time_encoding(ft->type, raw);
         if (encoding == TimeEncoding::kAbsoluteSeconds) {
           if (scan.timestamp_s == 0) scan.timestamp_s = raw;  // no header stamp: the first point's
@@ -186,6 +184,7 @@ void append_points(const unsigned char* data, std::size_t count, std::size_t str
         case TimeEncoding::kRelativeNanoseconds: q.time_s = static_cast<float>(raw * 1e-9); break;
         case TimeEncoding::kAbsoluteSeconds: q.time_s = static_cast<float>(raw - time_origin_s); break;
       }
+      if (!std::isfinite(q.time_s)) q.time_s = 0;
     }
     scan.points.push_back(q);
   }
@@ -193,7 +192,7 @@ void append_points(const unsigned char* data, std::size_t count, std::size_t str
   scan.has_time = ft != nullptr;
 }
 
-std::vector<std::string> describe_fields(const std::vector<PointField>& fields) {
+std::vector<std::string> describe_fields(const std::vector<CloudField>& fields) {
   std::vector<std::string> out;
   for (const auto& f : fields) {
     std::string s = f.name + ":" + field_type_name(f.type);

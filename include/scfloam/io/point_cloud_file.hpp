@@ -14,7 +14,7 @@ namespace scfloam {
 // One file as read: the scan (non-finite points dropped) and what the file declared.
 struct PointCloudFile {
   Scan scan;
-  std::vector<PointField> fields;  // as declared, offsets within one packed point
+  std::vector<CloudField> fields;  // as declared, offsets within one packed point
   std::string format;              // "PCD binary_compressed", "PLY binary_big_endian", ...
   std::size_t declared_points = 0; // points in the file, including dropped NaN ones
 };

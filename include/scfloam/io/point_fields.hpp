@@ -20,28 +20,29 @@ std::optional<FieldType> field_type_from_pcd(char type, std::size_t size);
 // PLY's type names (float, float32, uchar, uint8, ...); nullopt when unknown.
 std::optional<FieldType> field_type_from_ply(const std::string& name);
 
-struct PointField {
+struct CloudField {
   std::string name;
   std::size_t offset = 0;  // bytes from the start of a point
   FieldType type = FieldType::kFloat32;
   std::size_t count = 1;   // elements; only the first is read
 };
 
-// Which field feeds which LidarPoint member, by name (case-insensitive):
-//   x, y, z; intensity | reflectivity | reflectance | i; ring | channel | laser_id | line;
-//   time | t | timestamp | time_offset | offset_time | time_stamp.
+// Which field feeds which LidarPoint member, by name (case-insensitive; the first name of each
+// list that is present wins): x, y, z; intensity | reflectivity | reflectance | i;
+// ring | channel; time | t | time_offset | offset_time | timestamp | ts.
 // Indices into the field list, -1 when absent. Throws Error when x, y or z is missing.
 struct PointLayout {
   int x = -1, y = -1, z = -1, intensity = -1, ring = -1, time = -1;
 };
-PointLayout map_point_fields(const std::vector<PointField>& fields);
+PointLayout map_point_fields(const std::vector<CloudField>& fields);
 
-// Per-point time to LidarPoint::time_s (seconds relative to the scan stamp), decided by type:
-//   integer types      -> nanoseconds relative to the scan (Ouster `t` uint32, Livox offset_time)
-//   float32            -> seconds relative to the scan (Velodyne `time`)
-//   float64 below 1e6  -> seconds relative to the scan
-//   float64 from 1e6   -> absolute seconds (Hesai/Livox `timestamp`): minus the scan stamp, or
-//                         minus the first point's time when the scan has no stamp
+// Per-point time to LidarPoint::time_s (seconds relative to the scan stamp), decided once per
+// scan from the type and the first point's value (the bag readers' PointCloud2 rule too):
+//   integer types        -> nanoseconds relative to the scan (Ouster `t`, Livox offset_time)
+//   floats up to 1e6     -> seconds relative to the scan (Velodyne `time`)
+//   floats above 1e6     -> absolute seconds (Hesai/Livox `timestamp`): minus the scan stamp,
+//                           or, when the scan has none (PCD/PLY), the first point's time
+//                           becomes the scan stamp
 enum class TimeEncoding { kRelativeSeconds, kRelativeNanoseconds, kAbsoluteSeconds };
 TimeEncoding time_encoding(FieldType type, double first_value);
 
@@ -49,11 +50,11 @@ TimeEncoding time_encoding(FieldType type, double first_value);
 // x, y or z is not finite (organized clouds). Sets scan.has_ring / has_time when the layout has
 // those fields (every point then carries them). `big_endian` for PLY/PointCloud2 data.
 void append_points(const unsigned char* data, std::size_t count, std::size_t stride,
-                   const std::vector<PointField>& fields, const PointLayout& layout,
+                   const std::vector<CloudField>& fields, const PointLayout& layout,
                    bool big_endian, Scan& scan);
 
 // "x:float32" per field (count > 1 as "normal:float32[3]"), as `scfloam info` prints them.
-std::vector<std::string> describe_fields(const std::vector<PointField>& fields);
+std::vector<std::string> describe_fields(const std::vector<CloudField>& fields);
 
 }  // namespace scfloam
 
