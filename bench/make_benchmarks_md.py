@@ -9,7 +9,8 @@ import subprocess
 import sys
 import time
 
-results, out_path, repeat, sequences, modes = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4].split(), sys.argv[5].split()
+results, out_path, repeat, seq_args, modes = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4].split(), sys.argv[5].split()
+sequences = [s.split(":")[0] for s in seq_args]  # "kitti00:1" runs kitti00 once
 
 PAPER = {  # Table I of the paper (KITTI 00 / 05): t_err %, r_err deg/100 m, ms per loop frame
     "optimized": ("0.75 / 0.43", "0.27 / 0.22", "135 / 129"),
@@ -44,7 +45,7 @@ w("")
 w(f"Measured {time.strftime('%Y-%m-%d')} on {os.cpu_count()} cores ({cpu_model()}), "
   f"Release build, medians over {repeat} repetitions unless a row says otherwise.")
 w("Reproduce with `bash bench/run_benchmarks.sh` "
-  f"(here: `REPEAT={repeat} SEQUENCES=\"{' '.join(sequences)}\" bash bench/run_benchmarks.sh`).")
+  f"(here: `REPEAT={repeat} SEQUENCES=\"{' '.join(seq_args)}\" bash bench/run_benchmarks.sh`).")
 w("")
 
 w("## Micro-benchmarks (Google Benchmark, median wall time)")
@@ -75,16 +76,14 @@ w("t_err / r_err: KITTI devkit metric against the simulator's ground truth. Timi
   "summary.json: per frame (features + registration), loop detection per keyframe, loop "
   "registration per loop frame, optimization per accepted loop.")
 w("")
-w("| sequence | mode | frames | t_err % | r_err deg/100m | ATE m | frames/s | features ms | registration ms | loop det. ms | ms per loop frame | optimization ms | loops accepted / candidates | peak MB |")
-w("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+w("| sequence | mode | runs | frames | t_err % | r_err deg/100m | ATE m | frames/s | features ms | registration ms | loop det. ms | ms per loop frame | optimization ms | loops accepted / candidates | peak MB |")
+w("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
 table = {}
 for seq in sequences:
     for mode in modes:
         runs = []
-        for r in range(1, repeat + 1):
-            path = os.path.join(results, f"run-{seq}-{mode}-{r}", "summary.json")
-            if os.path.exists(path):
-                runs.append(json.load(open(path)))
+        for path in sorted(glob.glob(os.path.join(results, f"run-{seq}-{mode}-*", "summary.json"))):
+            runs.append(json.load(open(path)))
         if not runs:
             continue
         acc = lambda key: med([(run.get("accuracy") or {}).get(key) for run in runs])
@@ -95,7 +94,7 @@ for seq in sequences:
             "fps": med([run["fps"] for run in runs]), "loop_ms": tim("loop_registration"),
         }
         table[(seq, mode)] = row
-        w(f"| {seq} | {mode} | {runs[0]['frames']} | {fmt(row['t_err'], 3)} | {fmt(row['r_err'], 4)} | "
+        w(f"| {seq} | {mode} | {len(runs)} | {runs[0]['frames']} | {fmt(row['t_err'], 3)} | {fmt(row['r_err'], 4)} | "
           f"{fmt(row['ate'], 3)} | {fmt(row['fps'], 1)} | {fmt(tim('features'))} | {fmt(tim('registration'))} | "
           f"{fmt(tim('loop_detection'))} | {fmt(row['loop_ms'], 1)} | {fmt(tim('optimization'), 1)} | "
           f"{loops.get('accepted', '-')} / {loops.get('candidates', '-')} | "

@@ -4,6 +4,7 @@
 # runs). Run it on a quiet machine; it says how many cores it saw.
 #   bash bench/run_benchmarks.sh                 # default set
 #   REPEAT=5 SEQUENCES="city-loops kitti05" bash bench/run_benchmarks.sh
+#   SEQUENCES="city-loops-short kitti05 kitti00:1"   # NAME:N runs that sequence N times instead
 set -euo pipefail
 cd "$(dirname "$0")/.."
 repeat="${REPEAT:-3}"
@@ -33,7 +34,10 @@ sim_args() {
   esac
 }
 
-for seq in $sequences; do
+for entry in $sequences; do
+  seq="${entry%%:*}"
+  runs="$repeat"
+  [ "$entry" != "$seq" ] && runs="${entry#*:}"
   dir="data/bench/$seq"
   if [ ! -f "$dir/poses.txt" ]; then
     echo "== simulating $seq"
@@ -45,8 +49,9 @@ for seq in $sequences; do
     echo "{\"sequence\": \"$seq\", \"frames\": $frames, \"ms\": $(( (end - start) / 1000000 ))}" > "$results/sim-$seq.json"
   fi
   for mode in $modes; do
-    for r in $(seq 1 "$repeat"); do
-      echo "== $seq $mode run $r/$repeat"
+    rm -rf "$results"/run-"$seq"-"$mode"-*
+    for r in $(seq 1 "$runs"); do
+      echo "== $seq $mode run $r/$runs"
       "$bin/scfloam" run "$dir" --mode "$mode" --out "$results/run-$seq-$mode-$r" --force --quiet > /dev/null
     done
   done
