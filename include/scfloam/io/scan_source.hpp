@@ -32,7 +32,18 @@ struct ScanSourceOptions {
   std::filesystem::path timestamps_file;    // folders: one stamp per scan (else from names/headers)
 };
 
-// Detects the kind of input at `path` and opens it; Error naming the path when it cannot.
+enum class InputKind { kKitti, kBag, kScanFolder, kScanFile };
+
+// What `path` is, by names and magic bytes only (nothing is parsed). Error naming the path and
+// listing what was looked for when it is none of the kinds.
+InputKind detect_input_kind(const std::filesystem::path& path);
+
+// A KITTI odometry sequence directory (velodyne/, calib.txt, times.txt, optional poses.txt).
+std::unique_ptr<ScanSource> open_kitti_source(const std::filesystem::path& dir);
+
+// Detects the kind of input at `path` and opens it: a bag (is_bag_input), a KITTI directory
+// (velodyne/), a folder of .pcd/.ply/.bin scans (one kind), or a single scan file.
+// Error naming the path when it cannot; `options.timestamps_file` is refused for bags and KITTI.
 std::unique_ptr<ScanSource> open_scan_source(const std::filesystem::path& path,
                                              const ScanSourceOptions& options = {});
 

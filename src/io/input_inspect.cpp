@@ -1,0 +1,82 @@
+#include "scfloam/io/input_inspect.hpp"
+
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+#include "scfloam/io/bag_source.hpp"
+#include "scfloam/io/folder_source.hpp"
+#include "scfloam/io/kitti.hpp"
+
+namespace scfloam {
+namespace fs = std::filesystem;
+namespace {
+
+InputInfo inspect_kitti(const fs::path& dir) {
+  const KittiSequence seq = KittiSequence::open(dir);
+  InputInfo info;
+  info.kind = "KITTI sequence";
+  info.scans = seq.size();
+  info.point_fields = {"x:float32", "y:float32", "z:float32", "reflectance:float32"};
+  info.points_in_first_scan = seq.load(0).points.size();
+  if (!seq.times().empty()) {
+    info.start_time_s = seq.times().front();
+    info.end_time_s = seq.times().back();
+  }
+  info.notes.push_back(seq.ground_truth_camera() ? "ground truth poses.txt: accuracy is reported"
+                                                 : "no poses.txt: no accuracy report");
+  info.notes.push_back(seq.calib().has_Tr ? "calib.txt has Tr: poses_kitti.txt in camera-0 convention by default"
+                                          : "no Tr in calib.txt: poses in the lidar frame (--frame camera refused)");
+  info.notes.push_back("no ring or time fields: rings from elevation, no deskew");
+  return info;
+}
+
+}  // namespace
+
+InputInfo inspect_input(const fs::path& path, const ScanSourceOptions& options) {
+  switch (detect_input_kind(path)) {
+    case InputKind::kBag: return inspect_bag(path, options);
+    case InputKind::kKitti: return inspect_kitti(path);
+    case InputKind::kScanFolder: return inspect_file_list(list_scan_folder(path), options);
+    case InputKind::kScanFile: return inspect_file_list(single_scan_file(path), options);
+  }
+  return {};
+}
+
+std::string input_info_text(const InputInfo& info) {
+  std::string out = "kind:      " + info.kind + "\n";
+  char line[256];
+  if (!info.topics.empty()) {
+    out += "topics:\n";
+    for (const auto& t : info.topics) {
+      std::snprintf(line, sizeof line, "  %-32s %-32s %zu messages\n", t.name.c_str(), t.type.c_str(), t.messages);
+      out += line;
+    }
+    out += "scan topic: " + (info.scan_topic.empty() ? std::string("(none)") : info.scan_topic) + "\n";
+  }
+  out += "scans:     " + std::to_string(info.scans) + "\n";
+  out += "fields:   ";
+  for (const auto& f : info.point_fields) out += " " + f;
+  out += "\npoints in the first scan: " + std::to_string(info.points_in_first_scan) + "\n";
+  std::snprintf(line, sizeof line, "time span: %.6f .. %.6f s (%.3f s)\n", info.start_time_s, info.end_time_s,
+                info.end_time_s - info.start_time_s);
+  out += line;
+  for (const auto& n : info.notes) out += "note:      " + n + "\n";
+  return out;
+}
+
+std::string input_info_json(const InputInfo& info) {
+  nlohmann::json j;
+  j["kind"] = info.kind;
+  j["topics"] = nlohmann::json::array();
+  for (const auto& t : info.topics) j["topics"].push_back({{"name", t.name}, {"type", t.type}, {"messages", t.messages}});
+  j["scan_topic"] = info.scan_topic;
+  j["scans"] = info.scans;
+  j["point_fields"] = info.point_fields;
+  j["points_in_first_scan"] = info.points_in_first_scan;
+  j["start_time_s"] = info.start_time_s;
+  j["end_time_s"] = info.end_time_s;
+  j["notes"] = info.notes;
+  return j.dump(2) + "\n";
+}
+
+}  // namespace scfloam
