@@ -3,6 +3,9 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
+#include <unistd.h>
+#include <yaml-cpp/yaml.h>
 
 #include "command_registry.hpp"
 #include "interrupt.hpp"
@@ -18,6 +21,13 @@ struct RunArgs {
   std::string out_dir;
   std::string mode = "optimized";
   std::string config_file;
+  std::string sensor;
+  std::string topic;
+  std::string timestamps;
+  std::string frame = "auto";
+  double map_voxel_m = 0.2;
+  bool ply = false;
+  bool save_keyframes = false;
   std::size_t frames = 0;
   bool force = false;
   bool quiet = false;
@@ -58,11 +68,75 @@ void print_report(const nlohmann::json& summary) {
   if (summary.contains("accuracy")) accuracy_line(summary["mode"].get<std::string>().c_str(), summary["accuracy"]);
 }
 
+// config/ beside the sources: $SCFLOAM_CONFIG_DIR, else <binary>/../../config (build*/bin/scfloam).
+std::filesystem::path preset_path(const std::string& sensor) {
+  if (sensor == "livox")
+    throw Error("--sensor livox: not supported. The feature extraction works on scan rings (a ring field, "
+                "or rings from the elevation of a multi-beam fan) and takes curvature along each ring; a "
+                "Livox non-repetitive pattern has neither (docs/inputs.md)");
+  const char* names[][2] = {{"hdl64", "kitti-hdl64"}, {"hdl32", "hdl32"}, {"vlp16", "vlp16"},
+                            {"os1-64", "os1-64"}, {"os1-128", "os1-128"}};
+  std::string file;
+  for (const auto& n : names)
+    if (sensor == n[0]) file = std::string(n[1]) + ".yaml";
+  if (file.empty())
+    throw Error("--sensor: unknown sensor '" + sensor + "' (hdl64, hdl32, vlp16, os1-64, os1-128, livox)");
+  std::vector<std::filesystem::path> dirs;
+  if (const char* env = std::getenv("SCFLOAM_CONFIG_DIR")) dirs.emplace_back(env);
+  std::error_code ec;
+  const auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (!ec) dirs.push_back(exe.parent_path().parent_path().parent_path() / "config");
+  for (const auto& d : dirs)
+    if (std::filesystem::exists(d / file)) return d / file;
+  std::string looked;
+  for (const auto& d : dirs) looked += " " + (d / file).string();
+  throw Error("--sensor " + sensor + ": preset not found (looked at" + looked + "; set SCFLOAM_CONFIG_DIR)");
+}
+
+void overlay(YAML::Node base, const YAML::Node& top) {
+  for (const auto& kv : top) {
+    const std::string key = kv.first.as<std::string>();
+    if (kv.second.IsMap() && base[key] && base[key].IsMap()) overlay(base[key], kv.second);
+    else base[key] = kv.second;
+  }
+}
+
+// --sensor picks a preset; --config on top of it overrides the keys it sets.
+SlamConfig load_run_config(const RunArgs& args) {
+  if (args.sensor.empty()) return args.config_file.empty() ? SlamConfig{} : load_config(args.config_file);
+  const SlamConfig preset = load_config(preset_path(args.sensor));
+  if (args.config_file.empty()) return preset;
+  load_config(args.config_file);  // its own errors name the user's file
+  YAML::Node merged = YAML::Load(config_to_yaml(preset));
+  overlay(merged, YAML::LoadFile(args.config_file));
+  const auto tmp = std::filesystem::temp_directory_path() / ("scfloam-config-" + std::to_string(::getpid()) + ".yaml");
+  {
+    std::ofstream out(tmp);
+    out << YAML::Dump(merged) << "\n";
+  }
+  const SlamConfig config = load_config(tmp);
+  std::filesystem::remove(tmp);
+  return config;
+}
+
 void run(const RunArgs& args) {
   const auto mode = parse_mode(args.mode);
   if (!mode) throw Error("--mode: unknown mode '" + args.mode + "' (odometry, simple-sc, optimized)");
-  const SlamConfig config = args.config_file.empty() ? SlamConfig{} : load_config(args.config_file);
-  const auto source = open_scan_source(args.input);
+  const auto frame = parse_pose_frame(args.frame);
+  if (!frame) throw Error("--frame: unknown frame '" + args.frame + "' (lidar, camera, auto)");
+  const SlamConfig config = load_run_config(args);
+  ScanSourceOptions source_options;
+  source_options.topic = args.topic;
+  source_options.timestamps_file = args.timestamps;
+  const auto source = open_scan_source(args.input, source_options);
+  OutputOptions outputs;
+  outputs.map_voxel_m = args.map_voxel_m;
+  outputs.write_ply = args.ply;
+  outputs.save_keyframes = args.save_keyframes;
+  outputs.frame = *frame;
+  outputs.map_min_range_m = config.odometry.preprocess.min_range_m;
+  outputs.map_max_range_m = config.odometry.preprocess.max_range_m;
+  check_output_options(*source, outputs);
   std::filesystem::path out_dir = args.out_dir;
   if (out_dir.empty())
     out_dir = std::filesystem::path("scfloam_out") /
@@ -79,7 +153,7 @@ void run(const RunArgs& args) {
   const RunResult result = run_slam(*source, config, options);
   nlohmann::json summary = make_summary(*source, result);
   summary["interrupted"] = result.interrupted;
-  write_run_outputs(out_dir, *source, result, summary);
+  write_run_outputs(out_dir, *source, result, summary, outputs);
   print_report(summary);
   std::printf("results in %s\n", out_dir.string().c_str());
   if (result.interrupted) {
@@ -94,11 +168,22 @@ void run(const RunArgs& args) {
 RegisterCommand reg("run", [](CLI::App& app) {
   auto args = std::make_shared<RunArgs>();
   auto* sub = app.add_subcommand("run", "Run SLAM on a recorded sequence (default mode: optimized, the paper's method)");
-  sub->add_option("input", args->input, "Input sequence (KITTI odometry directory)")->required();
+  sub->add_option("input", args->input,
+                  "Input: KITTI directory, folder of .pcd/.ply/.bin scans, scan file, or ROS bag (see `scfloam info`)")
+      ->required();
   sub->add_option("-o,--out", args->out_dir, "Output folder (default: scfloam_out/<input name>)");
   sub->add_option("-m,--mode", args->mode, "odometry | simple-sc | optimized");
   sub->add_option("-c,--config", args->config_file, "YAML configuration (see config/)");
   sub->add_option("-n,--frames", args->frames, "Process only the first N scans");
+  sub->add_option("-s,--sensor", args->sensor,
+                  "Sensor preset: hdl64 | hdl32 | vlp16 | os1-64 | os1-128 (config/); --config overrides its keys");
+  sub->add_option("--topic", args->topic, "Bags: the PointCloud2 topic (auto when there is only one)");
+  sub->add_option("--timestamps", args->timestamps, "Folders: file with one stamp (s) per scan, in scan order");
+  sub->add_option("--frame", args->frame, "KITTI trajectories in lidar | camera | auto (camera when the input has Tr)");
+  sub->add_option("--map-voxel", args->map_voxel_m, "Voxel size of map.pcd/map.ply in metres (default 0.2)");
+  sub->add_flag("--ply", args->ply, "Also write map.ply (binary little endian, x y z intensity)");
+  sub->add_flag("--save-keyframes", args->save_keyframes,
+                "Write keyframes/NNNNNN.pcd (lidar frame) and keyframes/poses_kitti.txt to rebuild maps");
   sub->add_flag("-f,--force", args->force, "Overwrite an existing result in the output folder");
   sub->add_flag("-q,--quiet", args->quiet, "No progress bar");
   sub->add_flag("--deterministic", args->deterministic,
