@@ -1,5 +1,6 @@
 // ROS 1 bag 2.0 through Debian's librosbag (rosbag_storage): it handles the chunk formats
 // (none, bz2, lz4), connection and index records; we take the serialized bytes of each message.
+#include <console_bridge/console.h>
 #include <rosbag/bag.h>
 #include <rosbag/query.h>
 #include <rosbag/view.h>
@@ -16,6 +17,9 @@ namespace {
 class Ros1BagFile final : public BagFile {
  public:
   explicit Ros1BagFile(const std::filesystem::path& path) : path_(path) {
+    // librosbag also prints its errors through console_bridge; they reach the user as the
+    // Error below instead, once.
+    console_bridge::setLogLevel(console_bridge::CONSOLE_BRIDGE_LOG_NONE);
     try {
       bag_.open(path.string(), rosbag::bagmode::Read);
       rosbag::View all(bag_);

@@ -13,12 +13,34 @@
 namespace scfloam {
 namespace {
 
+std::string uri_escape(const std::string& path) {
+  static const char* hex = "0123456789ABCDEF";
+  std::string out;
+  for (const unsigned char c : path) {
+    if (c == '%' || c == '?' || c == '#' || c < 0x20 || c >= 0x7F) {
+      out += '%';
+      out += hex[c >> 4];
+      out += hex[c & 15];
+    } else {
+      out += static_cast<char>(c);
+    }
+  }
+  return out;
+}
+
 class Database {
  public:
   explicit Database(const std::filesystem::path& path) : path_(path) {
-    // Read-only: never checkpoints or removes the -wal / -shm files of a bag left by a crash.
-    if (sqlite3_open_v2(path.c_str(), &db_, SQLITE_OPEN_READONLY | SQLITE_OPEN_FULLMUTEX, nullptr) !=
-        SQLITE_OK)
+    // Bags are never written here. Without a non-empty write-ahead log the database is opened
+    // immutable, so that SQLite touches no file next to it (as root it would rewrite the
+    // -shm / -wal files even of a read-only connection). A non-empty -wal holds messages of a
+    // recording that was not closed cleanly: it must be read, so that case opens read-only.
+    std::error_code ec;
+    const auto wal = std::filesystem::path(path.string() + "-wal");
+    const bool wal_has_data = std::filesystem::exists(wal, ec) && std::filesystem::file_size(wal, ec) > 0;
+    const std::string target = wal_has_data ? path.string() : "file:" + uri_escape(path.string()) + "?immutable=1";
+    if (sqlite3_open_v2(target.c_str(), &db_, SQLITE_OPEN_READONLY | SQLITE_OPEN_FULLMUTEX | SQLITE_OPEN_URI,
+                        nullptr) != SQLITE_OK)
       fail("cannot open as sqlite3");
   }
   ~Database() { sqlite3_close(db_); }

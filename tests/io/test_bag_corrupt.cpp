@@ -1,0 +1,87 @@
+// Truncated and corrupted bags of every kind: an Error naming the file, never a crash.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <iterator>
+
+#include "scfloam/error.hpp"
+#include "scfloam/io/bag_source.hpp"
+#include "test_paths.hpp"
+
+namespace scfloam {
+namespace {
+
+std::vector<char> slurp(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// Opens, inspects and loads every scan; returns false when an Error was thrown. Any other
+// exception or a crash fails the test.
+bool read_all(const std::filesystem::path& path) {
+  try {
+    inspect_bag(path, {});
+    const auto source = open_bag_source(path, {});
+    for (std::size_t i = 0; i < source->size(); ++i) source->load(i);
+    return true;
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(path.filename().string()), std::string::npos) << e.what();
+    return false;
+  }
+}
+
+void damage(const std::filesystem::path& original, const std::string& tag) {
+  const std::vector<char> bytes = slurp(original);
+  ASSERT_FALSE(bytes.empty());
+  const auto dir = test::scratch_dir("bag_corrupt_" + tag);
+  const auto path = dir / original.filename();
+  int errors = 0, cases = 0;
+  // Truncations at 12 places, then byte flips in 40 places.
+  for (int k = 0; k < 12; ++k) {
+    const std::size_t n = bytes.size() * static_cast<std::size_t>(k) / 12;
+    std::ofstream(path, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(n));
+    errors += !read_all(path);
+    ++cases;
+  }
+  for (int k = 0; k < 40; ++k) {
+    std::vector<char> copy = bytes;
+    const std::size_t at = (bytes.size() * static_cast<std::size_t>(k * 7919 % 40)) / 40;
+    for (std::size_t j = at; j < std::min(copy.size(), at + 8); ++j) copy[j] = static_cast<char>(copy[j] ^ 0x5A);
+    std::ofstream(path, std::ios::binary).write(copy.data(), static_cast<std::streamsize>(copy.size()));
+    read_all(path);
+    ++cases;
+  }
+  EXPECT_GE(errors, 11) << tag << ": truncated files must not read as complete bags";
+}
+
+TEST(BagCorrupt, Ros1) {
+  SCFLOAM_SHARED_DATA_OR_SKIP(p, "bags/cdcpd/rope_example_10_points_2020-02-20-16-58-46.bag");
+  damage(p, "ros1");
+}
+
+TEST(BagCorrupt, Mcap) {
+  SCFLOAM_SHARED_DATA_OR_SKIP(p, "bags/rosbags-rs/tests/test_bags/test_bag_mcap/test_bag_mcap.mcap");
+  damage(p, "mcap");
+}
+
+TEST(BagCorrupt, Sqlite) {
+  SCFLOAM_SHARED_DATA_OR_SKIP(p, "bags/rosbags-rs/tests/test_bags/test_bag_sqlite3/test_bag_sqlite3.db3");
+  damage(p, "sqlite");
+}
+
+TEST(BagCorrupt, NotABag) {
+  const auto dir = test::scratch_dir("bag_not");
+  std::ofstream(dir / "x.bag") << "hello";
+  EXPECT_THROW(open_bag_source(dir / "x.bag", {}), Error);
+  std::ofstream(dir / "x.mcap") << "hello";
+  EXPECT_THROW(open_bag_source(dir / "x.mcap", {}), Error);
+  std::ofstream(dir / "x.db3") << "hello world, not sqlite";
+  EXPECT_THROW(open_bag_source(dir / "x.db3", {}), Error);
+  EXPECT_THROW(open_bag_source(dir / "missing.bag", {}), Error);
+  std::filesystem::create_directories(dir / "b");
+  std::ofstream(dir / "b" / "metadata.yaml") << "rosbag2_bagfile_information: [\n";
+  EXPECT_THROW(open_bag_source(dir / "b", {}), Error);
+}
+
+}  // namespace
+}  // namespace scfloam
