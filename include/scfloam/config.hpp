@@ -63,6 +63,12 @@ struct RegistrationConfig {
   // Smallest eigenvalue of the translation block of J^T J (in units of "well-constrained
   // residuals") below which a solve is reported degenerate.
   double degeneracy_min_eigenvalue = 50.0;
+  // Same for the rotation block (units: residuals x lever arm^2 in m^2; a frame's structure
+  // 5-30 m away gives 10^4 and more, a flat open field ~0 about the vertical).
+  double degeneracy_min_rotation_eigenvalue = 50.0;
+  // Solution remapping: along the weak eigenvectors (of either block) the solve keeps the
+  // constant-velocity prediction and moves only in the well-constrained directions.
+  bool degeneracy_fallback = true;
   int num_threads = 2;               // TBB correspondence search and Ceres evaluation
 };
 

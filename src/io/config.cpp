@@ -2,6 +2,7 @@
 // writing and the unknown-key check can never disagree about which keys exist.
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
 #include <functional>
 #include <sstream>
 #include <variant>
@@ -55,6 +56,9 @@ std::vector<Binding> bindings(SlamConfig& c) {
       {reg, "converged_translation_m", &o.registration.converged_translation_m},
       {reg, "converged_rotation_deg", &o.registration.converged_rotation_deg},
       {reg, "degeneracy_min_eigenvalue", &o.registration.degeneracy_min_eigenvalue},
+      {reg, "degeneracy_min_rotation_eigenvalue",
+       &o.registration.degeneracy_min_rotation_eigenvalue},
+      {reg, "degeneracy_fallback", &o.registration.degeneracy_fallback},
       {reg, "num_threads", &o.registration.num_threads},
       {map, "edge_spacing_m", &o.map.edge_spacing_m},
       {map, "plane_spacing_m", &o.map.plane_spacing_m},
@@ -109,6 +113,8 @@ std::vector<Binding> bindings(SlamConfig& c) {
       {pg, "loop_outlier_chi2", &g.loop_outlier_chi2},
       {pg, "max_outlier_rounds", &g.max_outlier_rounds},
       {pg, "max_iterations", &g.max_iterations},
+      {pg, "estimate_odometry_drift", &g.estimate_odometry_drift},
+      {pg, "odometry_drift_prior_deg_per_100m", &g.odometry_drift_prior_deg_per_100m},
   });
   auto& p = c.pipeline;
   const std::string pl = "pipeline";
@@ -132,7 +138,11 @@ std::vector<std::string> split_dots(const std::string& s) {
 void check_known(const YAML::Node& node, const std::string& prefix,
                  const std::vector<Binding>& table, const std::filesystem::path& path) {
   for (const auto& kv : node) {
-    const std::string name = kv.first.as<std::string>();
+    if (!kv.first.IsScalar())
+      throw file_error(path, "a key " + (prefix.empty() ? std::string("at the top level")
+                                                          : "under `" + prefix + "`") +
+                                 " is not a plain name");
+    const std::string name = kv.first.Scalar();
     const std::string full = prefix.empty() ? name : prefix + "." + name;
     bool is_section = false, is_key = false;
     for (const auto& b : table) {
@@ -155,6 +165,44 @@ void read_scalar(const YAML::Node& n, T* out, const std::string& full,
   } catch (const YAML::Exception&) {
     throw file_error(path, "`" + full + "` must be " + type_name + ", got `" + n.Scalar() + "`");
   }
+  if constexpr (std::is_same_v<T, double>)
+    if (!std::isfinite(*out)) throw file_error(path, "`" + full + "` must be a finite number");
+}
+
+// Values the stages divide by, size buffers with or loop over: a zero or negative one would
+// hang or crash a run far from the config file, so it is refused here, naming the key.
+void check_ranges(const SlamConfig& c, const std::filesystem::path& path) {
+  auto require = [&](bool ok, const char* key, const char* rule) {
+    if (!ok) throw file_error(path, std::string("`") + key + "` must be " + rule);
+  };
+  const auto& o = c.odometry;
+  require(o.preprocess.min_range_m >= 0, "odometry.preprocess.min_range_m", ">= 0");
+  require(o.preprocess.max_range_m > o.preprocess.min_range_m, "odometry.preprocess.max_range_m",
+          "> min_range_m");
+  require(o.rings.min_points_per_ring >= 0, "odometry.rings.min_points_per_ring", ">= 0");
+  require(o.features.curvature_half_window >= 1, "odometry.features.curvature_half_window", ">= 1");
+  require(o.features.sectors_per_ring >= 1, "odometry.features.sectors_per_ring", ">= 1");
+  require(o.features.max_edges_per_sector >= 0, "odometry.features.max_edges_per_sector", ">= 0");
+  require(o.features.edge_leaf_m > 0, "odometry.features.edge_leaf_m", "> 0");
+  require(o.features.plane_leaf_m > 0, "odometry.features.plane_leaf_m", "> 0");
+  require(o.registration.knn >= 1, "odometry.registration.knn", ">= 1");
+  require(o.registration.max_neighbor_dist_m > 0, "odometry.registration.max_neighbor_dist_m", "> 0");
+  require(o.registration.inner_iterations >= 1, "odometry.registration.inner_iterations", ">= 1");
+  require(o.registration.outer_iterations >= 1, "odometry.registration.outer_iterations", ">= 1");
+  require(o.registration.num_threads >= 1, "odometry.registration.num_threads", ">= 1");
+  require(o.map.edge_spacing_m >= 0, "odometry.map.edge_spacing_m", ">= 0");
+  require(o.map.plane_spacing_m >= 0, "odometry.map.plane_spacing_m", ">= 0");
+  require(o.map.max_points_per_cell >= 1, "odometry.map.max_points_per_cell", ">= 1");
+  require(o.map.radius_m > 0, "odometry.map.radius_m", "> 0");
+  const auto& d = c.loop_detection;
+  require(d.descriptor.num_rings >= 1, "loop_detection.descriptor.num_rings", ">= 1");
+  require(d.descriptor.num_sectors >= 1, "loop_detection.descriptor.num_sectors", ">= 1");
+  require(d.descriptor.max_radius_m > 0, "loop_detection.descriptor.max_radius_m", "> 0");
+  require(d.num_candidates >= 1, "loop_detection.num_candidates", ">= 1");
+  require(d.tree_rebuild_every >= 1, "loop_detection.tree_rebuild_every", ">= 1");
+  require(c.loop_registration.icp_leaf_m > 0, "loop_registration.icp_leaf_m", "> 0");
+  require(c.pipeline.queue_capacity >= 1, "pipeline.queue_capacity", ">= 1");
+  require(c.pipeline.raw_leaf_m > 0, "pipeline.raw_leaf_m", "> 0");
 }
 
 }  // namespace
@@ -197,6 +245,7 @@ SlamConfig load_config(const std::filesystem::path& path) {
         },
         b.field);
   }
+  check_ranges(config, path);
   return config;
 }
 

@@ -79,6 +79,9 @@ OdometryResult Odometry::process(const Scan& scan) {
     result.plane_matches = reg.plane_matches;
     result.mean_residual_m = reg.mean_residual_m;
     result.min_translation_eigenvalue = reg.translation_eigenvalues[0];
+    result.min_rotation_eigenvalue = reg.rotation_eigenvalues[0];
+    result.weak_directions =
+        reg.fallback_applied ? reg.weak_rotation_dirs + reg.weak_translation_dirs : 0;
     s.rounds = std::max(c.registration.outer_iterations, s.rounds - 1);
     s.T_delta = orthonormalized(s.T_last.inverse() * result.T_world_lidar);
     s.delta_dt_s = scan.timestamp_s - s.last_stamp_s;

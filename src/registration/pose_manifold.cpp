@@ -41,6 +41,37 @@ bool PoseManifold::MinusJacobian(const double*, double* jacobian) const {
   return true;
 }
 
+bool SubspacePoseManifold::Plus(const double* x, const double* delta,
+                                double* x_plus_delta) const {
+  const Eigen::Matrix<double, 6, 1> full_delta =
+      basis_ * Eigen::Map<const Eigen::VectorXd>(delta, basis_.cols());
+  return full_.Plus(x, full_delta.data(), x_plus_delta);
+}
+
+bool SubspacePoseManifold::PlusJacobian(const double*, double* jacobian) const {
+  // [I_6; 0] * B, stored row-major 7 x m.
+  Eigen::Map<Eigen::Matrix<double, 7, Eigen::Dynamic, Eigen::RowMajor>> J(jacobian, 7,
+                                                                          basis_.cols());
+  J.setZero();
+  J.topRows<6>() = basis_;
+  return true;
+}
+
+bool SubspacePoseManifold::Minus(const double* y, const double* x, double* y_minus_x) const {
+  Eigen::Matrix<double, 6, 1> full_delta;
+  full_.Minus(y, x, full_delta.data());
+  Eigen::Map<Eigen::VectorXd>(y_minus_x, basis_.cols()) = basis_.transpose() * full_delta;
+  return true;
+}
+
+bool SubspacePoseManifold::MinusJacobian(const double*, double* jacobian) const {
+  Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, 7, Eigen::RowMajor>> J(jacobian,
+                                                                          basis_.cols(), 7);
+  J.setZero();
+  J.leftCols<6>() = basis_.transpose();
+  return true;
+}
+
 void pose_to_block(const Eigen::Isometry3d& T, double* block) {
   Eigen::Map<Eigen::Quaterniond> q(block);
   Eigen::Map<Eigen::Vector3d> t(block + 4);

@@ -8,6 +8,7 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <memory>
 
 #include "scfloam/error.hpp"
 #include "scfloam/registration/pose_manifold.hpp"
@@ -160,26 +161,113 @@ void ScanToMapRegistration::find_matches(const FeatureCloud& edges, const Featur
     if (plane_ok_[i]) plane_out_.push_back(plane_all_[i]);
 }
 
+namespace {
+
+using Matrix6 = Eigen::Matrix<double, 6, 6>;
+using Basis6 = Eigen::Matrix<double, 6, Eigen::Dynamic>;
+
+// Gauss-Newton Hessian J^T J (tangent [omega; v]) of the matches at T, robustified when
+// huber_delta_m > 0, and the sum of their point-to-line/plane distances before the loss.
+// Unrobustified, it measures the geometry alone: how many matches constrain each direction,
+// whatever their current residual (far from the solution the loss would hide a good wall).
+Matrix6 hessian_of(const std::vector<EdgeMatch>& edges, const std::vector<PlaneMatch>& planes,
+                   const Eigen::Isometry3d& T, double huber_delta_m, double* sum_dist) {
+  const Eigen::Matrix3d R = T.linear();
+  const Eigen::Vector3d t = T.translation();
+  Matrix6 H = Matrix6::Zero();
+  double dist = 0;
+  for (const auto& m : edges) {
+    Jacobian36 J;
+    Eigen::Vector3d r = edge_residual(m, R, t, &J);
+    dist += r.norm();
+    if (huber_delta_m > 0) robustify_huber<3>(huber_delta_m, r, &J);
+    H.noalias() += J.transpose() * J;
+  }
+  for (const auto& m : planes) {
+    Jacobian16 J;
+    Eigen::Matrix<double, 1, 1> r(plane_residual(m, R, t, &J));
+    dist += std::abs(r[0]);
+    if (huber_delta_m > 0) robustify_huber<1>(huber_delta_m, r, &J);
+    H.noalias() += J.transpose() * J;
+  }
+  if (sum_dist) *sum_dist = dist;
+  return H;
+}
+
+// Eigen-decomposition of the rotation and translation blocks (ascending) and how many
+// eigenvalues of each fall below their threshold. The blocks are analysed apart because
+// their units differ; PoseManifold's rotation about the sensor keeps them nearly decoupled.
+struct Conditioning {
+  Eigen::Vector3d rot_values, tra_values;
+  Eigen::Matrix3d rot_vectors, tra_vectors;
+  int weak_rot = 0, weak_tra = 0;
+
+  Conditioning(const Matrix6& H, const RegistrationConfig& config) {
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> rot(H.topLeftCorner<3, 3>());
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> tra(H.bottomRightCorner<3, 3>());
+    rot_values = rot.eigenvalues();
+    rot_vectors = rot.eigenvectors();
+    tra_values = tra.eigenvalues();
+    tra_vectors = tra.eigenvectors();
+    for (int i = 0; i < 3; ++i) {
+      weak_rot += rot_values[i] < config.degeneracy_min_rotation_eigenvalue;
+      weak_tra += tra_values[i] < config.degeneracy_min_eigenvalue;
+    }
+  }
+  int weak() const { return weak_rot + weak_tra; }
+
+  // Orthonormal 6 x m basis of the well-constrained (strong) or weak tangent directions.
+  Basis6 basis(bool strong) const {
+    const int nr = strong ? 3 - weak_rot : weak_rot, nt = strong ? 3 - weak_tra : weak_tra;
+    Basis6 B = Basis6::Zero(6, nr + nt);
+    const int r0 = strong ? weak_rot : 0, t0 = strong ? weak_tra : 0;
+    for (int i = 0; i < nr; ++i) B.block<3, 1>(0, i) = rot_vectors.col(r0 + i);
+    for (int i = 0; i < nt; ++i) B.block<3, 1>(3, nr + i) = tra_vectors.col(t0 + i);
+    return B;
+  }
+};
+
+bool finite_pose(const double* pose) {
+  for (int i = 0; i < 7; ++i)
+    if (!std::isfinite(pose[i])) return false;
+  return true;
+}
+
+}  // namespace
+
 RegistrationResult ScanToMapRegistration::align(const FeatureCloud& edges_lidar,
                                                 const FeatureCloud& planes_lidar,
                                                 const FeatureMap& map,
                                                 const Eigen::Isometry3d& T_world_lidar_init,
                                                 int rounds) {
   RegistrationResult result;
-  double pose[7];
-  pose_to_block(T_world_lidar_init, pose);
+  double init[7], pose[7];
+  pose_to_block(T_world_lidar_init, init);
+  std::copy(init, init + 7, pose);
   PoseManifold manifold;
   constexpr std::size_t kMinMatches = 10;  // fewer cannot pin down 6 dof with any margin
+  edge_out_.clear();
+  plane_out_.clear();
 
   for (int round = 0; round < rounds; ++round) {
     find_matches(edges_lidar, planes_lidar, map, block_to_pose(pose), round == 0);
     if (edge_out_.size() + plane_out_.size() < kMinMatches) break;
+    // Degenerate directions of this round's matches: the solver may not move along them
+    // (they would follow noise, and through the nonlinearity disturb the other directions).
+    std::unique_ptr<SubspacePoseManifold> subspace;
+    if (config_.degeneracy_fallback) {
+      const Conditioning cond(
+          hessian_of(edge_out_, plane_out_, block_to_pose(pose), 0.0, nullptr), config_);
+      if (cond.weak() == 6) break;  // nothing is constrained: keep the guess
+      if (cond.weak() > 0) subspace = std::make_unique<SubspacePoseManifold>(cond.basis(true));
+    }
     FeatureCost cost(edge_out_, plane_out_, config_.huber_delta_m);
     ceres::Problem::Options problem_options;
     problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
     problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
     ceres::Problem problem(problem_options);
-    problem.AddParameterBlock(pose, 7, &manifold);
+    problem.AddParameterBlock(pose, 7, subspace ? static_cast<ceres::Manifold*>(subspace.get())
+                                                : &manifold);
     problem.AddResidualBlock(&cost, nullptr, pose);
     ceres::Solver::Options options;
     options.linear_solver_type = ceres::DENSE_QR;  // 6 unknowns: dense is the right choice
@@ -189,7 +277,13 @@ RegistrationResult ScanToMapRegistration::align(const FeatureCloud& edges_lidar,
     options.num_threads = 1;
     ceres::Solver::Summary summary;
     const Eigen::Isometry3d T_before = block_to_pose(pose);
+    double before[7];
+    std::copy(pose, pose + 7, before);
     ceres::Solve(options, &problem, &summary);
+    if (!finite_pose(pose)) {  // never hand a NaN pose on: keep the last good one
+      std::copy(before, before + 7, pose);
+      break;
+    }
     ++result.rounds;
     const Eigen::Isometry3d step = T_before.inverse() * block_to_pose(pose);
     if (step.translation().norm() < config_.converged_translation_m &&
@@ -197,37 +291,36 @@ RegistrationResult ScanToMapRegistration::align(const FeatureCloud& edges_lidar,
       break;
   }
 
+  // Hessian and residuals of the final matches at the solution.
+  const std::size_t n = edge_out_.size() + plane_out_.size();
+  double sum_dist = 0;
+  result.hessian = n < kMinMatches ? Matrix6::Zero()
+                                   : hessian_of(edge_out_, plane_out_, block_to_pose(pose),
+                                                config_.huber_delta_m, &sum_dist);
+  const Conditioning cond(
+      n < kMinMatches ? Matrix6::Zero()
+                      : hessian_of(edge_out_, plane_out_, block_to_pose(pose), 0.0, nullptr),
+      config_);
+  // Solution remapping: whatever the rounds did along the final weak directions is undone,
+  // so the pose there is the initial guess (the motion model); the strong part is kept.
+  if (config_.degeneracy_fallback && cond.weak() > 0) {
+    Eigen::Matrix<double, 6, 1> delta;
+    manifold.Minus(pose, init, delta.data());
+    const Basis6 W = cond.basis(false);
+    delta -= W * (W.transpose() * delta);
+    manifold.Plus(init, delta.data(), pose);
+    result.fallback_applied = true;
+  }
   result.T_world_lidar = block_to_pose(pose);
   result.edge_matches = static_cast<int>(edge_out_.size());
   result.plane_matches = static_cast<int>(plane_out_.size());
-
-  // Hessian and residuals of the final matches at the solution.
-  const Eigen::Matrix3d R = result.T_world_lidar.linear();
-  const Eigen::Vector3d t = result.T_world_lidar.translation();
-  double sum_dist = 0;
-  for (const auto& m : edge_out_) {
-    Jacobian36 J;
-    Eigen::Vector3d r = edge_residual(m, R, t, &J);
-    sum_dist += r.norm();
-    robustify_huber<3>(config_.huber_delta_m, r, &J);
-    result.hessian += J.transpose() * J;
-  }
-  for (const auto& m : plane_out_) {
-    Jacobian16 J;
-    Eigen::Matrix<double, 1, 1> r(plane_residual(m, R, t, &J));
-    sum_dist += std::abs(r[0]);
-    robustify_huber<1>(config_.huber_delta_m, r, &J);
-    result.hessian += J.transpose() * J;
-  }
-  const std::size_t n = edge_out_.size() + plane_out_.size();
   result.mean_residual_m = n ? sum_dist / n : 0;
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> rot(result.hessian.topLeftCorner<3, 3>());
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> tra(result.hessian.bottomRightCorner<3, 3>());
-  result.rotation_eigenvalues = rot.eigenvalues();
-  result.translation_eigenvalues = tra.eigenvalues();
-  result.weakest_translation_dir = tra.eigenvectors().col(0);
-  result.degenerate = n < kMinMatches ||
-                      result.translation_eigenvalues[0] < config_.degeneracy_min_eigenvalue;
+  result.rotation_eigenvalues = cond.rot_values;
+  result.translation_eigenvalues = cond.tra_values;
+  result.weakest_translation_dir = cond.tra_vectors.col(0);
+  result.weak_rotation_dirs = cond.weak_rot;
+  result.weak_translation_dirs = cond.weak_tra;
+  result.degenerate = n < kMinMatches || cond.weak() > 0;
   return result;
 }
 

@@ -25,6 +25,10 @@ struct OdometryResult {
   int plane_matches = 0;
   double mean_residual_m = 0;
   double min_translation_eigenvalue = 0;  // of J^T J; see RegistrationConfig
+  double min_rotation_eigenvalue = 0;
+  // Weak directions (rotation + translation) where the pose kept the constant-velocity
+  // prediction (RegistrationConfig::degeneracy_fallback); 6 when nothing matched.
+  int weak_directions = 0;
 };
 
 class Odometry {

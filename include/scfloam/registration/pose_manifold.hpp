@@ -28,6 +28,26 @@ class PoseManifold : public ceres::Manifold {
   bool MinusJacobian(const double* x, double* jacobian) const override;
 };
 
+// PoseManifold restricted to a subspace of its tangent: delta = B a, with B's columns an
+// orthonormal basis (6 x m, 1 <= m <= 6) of the directions the solver may move in. Used when
+// the scan-to-map problem is degenerate: the weak directions keep the prediction
+// (solution remapping, Zhang et al. 2016) instead of following noise.
+class SubspacePoseManifold : public ceres::Manifold {
+ public:
+  explicit SubspacePoseManifold(const Eigen::Matrix<double, 6, Eigen::Dynamic>& basis)
+      : basis_(basis) {}
+  int AmbientSize() const override { return 7; }
+  int TangentSize() const override { return static_cast<int>(basis_.cols()); }
+  bool Plus(const double* x, const double* delta, double* x_plus_delta) const override;
+  bool PlusJacobian(const double* x, double* jacobian) const override;
+  bool Minus(const double* y, const double* x, double* y_minus_x) const override;
+  bool MinusJacobian(const double* x, double* jacobian) const override;
+
+ private:
+  Eigen::Matrix<double, 6, Eigen::Dynamic> basis_;
+  PoseManifold full_;
+};
+
 void pose_to_block(const Eigen::Isometry3d& T, double* block);
 Eigen::Isometry3d block_to_pose(const double* block);  // re-normalises the quaternion
 

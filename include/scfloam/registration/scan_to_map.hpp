@@ -40,10 +40,18 @@ struct RegistrationResult {
   int rounds = 0;              // correspondence rounds actually run
   // Gauss-Newton Hessian J^T J of the final round at the solution, tangent [omega; v].
   Eigen::Matrix<double, 6, 6> hessian = Eigen::Matrix<double, 6, 6>::Zero();
+  // Eigenvalues of the rotation and translation blocks of the unrobustified J^T J (the
+  // geometry of the matches: ~ number of matches constraining each direction), which decide
+  // the weak directions.
   Eigen::Vector3d rotation_eigenvalues = Eigen::Vector3d::Zero();     // ascending
   Eigen::Vector3d translation_eigenvalues = Eigen::Vector3d::Zero();  // ascending
   Eigen::Vector3d weakest_translation_dir = Eigen::Vector3d::Zero();  // world frame, unit
-  bool degenerate = false;  // smallest translation eigenvalue < degeneracy_min_eigenvalue
+  bool degenerate = false;  // some eigenvalue of either block below its degeneracy threshold
+  // Weak directions of the final round (eigenvalue below the threshold), and whether the
+  // solve kept the initial guess along them (RegistrationConfig::degeneracy_fallback).
+  int weak_rotation_dirs = 0;
+  int weak_translation_dirs = 0;
+  bool fallback_applied = false;
 };
 
 // Keeps its buffers between calls; one instance per thread.
