@@ -1,0 +1,203 @@
+// PCD: round trips of the three encodings, unusual layouts written by hand, files written by
+// another library (Open3D), and truncated/corrupt files.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <open3d/geometry/PointCloud.h>
+#include <open3d/io/PointCloudIO.h>
+#include <random>
+
+#include "scfloam/error.hpp"
+#include "scfloam/io/lzf.hpp"
+#include "scfloam/io/point_cloud_file.hpp"
+#include "test_paths.hpp"
+
+namespace fs = std::filesystem;
+using namespace scfloam;
+
+namespace {
+
+std::vector<LidarPoint> sample_points(std::size_t n) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(-50, 50);
+  std::vector<LidarPoint> pts(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    pts[i].x = u(rng);
+    pts[i].y = u(rng);
+    pts[i].z = u(rng) / 10;
+    pts[i].intensity = static_cast<float>(i % 256);
+    pts[i].ring = static_cast<std::int16_t>(i % 64);
+    pts[i].time_s = 0.1f * static_cast<float>(i) / static_cast<float>(n);
+  }
+  return pts;
+}
+
+void write_bytes(const fs::path& path, const std::string& bytes) {
+  std::ofstream out(path, std::ios::binary);
+  out << bytes;
+}
+
+template <typename T>
+void append(std::string& s, T v) {
+  s.append(reinterpret_cast<const char*>(&v), sizeof v);
+}
+
+std::string error_of(const fs::path& path) {
+  try {
+    read_pcd(path);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST(Lzf, RoundTripOfRepetitiveAndRandomData) {
+  std::vector<unsigned char> data(100000);
+  std::mt19937 rng(3);
+  for (std::size_t i = 0; i < data.size(); ++i) data[i] = i < 50000 ? static_cast<unsigned char>(i % 7) : rng() & 0xff;
+  const auto packed = lzf_compress(data.data(), data.size());
+  EXPECT_LT(packed.size(), data.size() * 6 / 10);  // the repetitive half compresses
+  const auto back = lzf_decompress(packed.data(), packed.size(), data.size());
+  ASSERT_TRUE(back);
+  EXPECT_EQ(*back, data);
+  EXPECT_FALSE(lzf_decompress(packed.data(), packed.size(), data.size() + 1));  // wrong size
+  std::vector<unsigned char> bad = {0xe0, 0x10, 0xff};  // reference before the start
+  EXPECT_FALSE(lzf_decompress(bad.data(), bad.size(), 20));
+}
+
+TEST(Pcd, RoundTripOfEveryEncodingWithAndWithoutRingAndTime) {
+  const fs::path dir = test::scratch_dir("pcd_round_trip");
+  const auto pts = sample_points(5000);
+  for (auto enc : {PcdEncoding::kAscii, PcdEncoding::kBinary, PcdEncoding::kBinaryCompressed}) {
+    for (bool ring_time : {false, true}) {
+      const fs::path path = dir / ("c" + std::to_string(int(enc)) + (ring_time ? "rt" : "") + ".pcd");
+      write_pcd(path, pts, enc, ring_time);
+      const PointCloudFile f = read_pcd(path);
+      ASSERT_EQ(f.scan.points.size(), pts.size()) << path;
+      EXPECT_EQ(f.scan.has_ring, ring_time);
+      EXPECT_EQ(f.scan.has_time, ring_time);
+      for (std::size_t i = 0; i < pts.size(); ++i) {
+        const auto& a = pts[i];
+        const auto& b = f.scan.points[i];
+        ASSERT_EQ(a.x, b.x) << i;  // ascii is written with 9 digits: float32 exact
+        ASSERT_EQ(a.y, b.y);
+        ASSERT_EQ(a.z, b.z);
+        ASSERT_EQ(a.intensity, b.intensity);
+        if (ring_time) {
+          ASSERT_EQ(a.ring, b.ring);
+          ASSERT_EQ(a.time_s, b.time_s);
+        }
+      }
+    }
+  }
+}
+
+TEST(Pcd, UnusualLayoutFieldOrderPaddingFloat64Uint8CountAndNaN) {
+  const fs::path path = test::scratch_dir("pcd_layout") / "odd.pcd";
+  // intensity (uint8) first, a 3-byte padding field `_`, z before x, x/y float64, a normal of
+  // COUNT 3, a uint32 nanosecond time; organized 2x2 with one NaN point.
+  std::string s =
+      "# odd\nVERSION .7\nFIELDS intensity _ z x y normal t\nSIZE 1 1 4 8 8 4 4\nTYPE U U F F F F U\n"
+      "COUNT 1 3 1 1 1 3 1\nWIDTH 2\nHEIGHT 2\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 4\nDATA binary\n";
+  for (int i = 0; i < 4; ++i) {
+    append<std::uint8_t>(s, static_cast<std::uint8_t>(200 + i));
+    s.append(3, '\0');
+    append<float>(s, 0.5f * i);
+    append<double>(s, i == 2 ? std::nan("") : 1.0 + i);
+    append<double>(s, -2.0 * i);
+    for (int k = 0; k < 3; ++k) append<float>(s, 9.f);
+    append<std::uint32_t>(s, 25000000u * i);
+  }
+  write_bytes(path, s);
+  const PointCloudFile f = read_pcd(path);
+  EXPECT_EQ(f.declared_points, 4u);
+  ASSERT_EQ(f.scan.points.size(), 3u);  // the NaN point is dropped
+  EXPECT_TRUE(f.scan.has_time);
+  EXPECT_FALSE(f.scan.has_ring);
+  const LidarPoint& p = f.scan.points[2];  // the input's 4th point
+  EXPECT_FLOAT_EQ(p.x, 4.0f);
+  EXPECT_FLOAT_EQ(p.y, -6.0f);
+  EXPECT_FLOAT_EQ(p.z, 1.5f);
+  EXPECT_FLOAT_EQ(p.intensity, 203.f);
+  EXPECT_NEAR(p.time_s, 0.075f, 1e-7);  // uint32 time: nanoseconds
+  ASSERT_EQ(f.fields.size(), 7u);
+  EXPECT_EQ(describe_fields(f.fields)[5], "normal:float32[3]");
+
+  // The same cloud as ASCII, with float64 absolute times: the first point's time is the stamp.
+  const fs::path ascii = path.parent_path() / "abs.pcd";
+  write_bytes(ascii,
+              "VERSION 0.7\nFIELDS x y z timestamp\nSIZE 4 4 4 8\nTYPE F F F F\nWIDTH 3\nHEIGHT 1\n"
+              "POINTS 3\nDATA ascii\n1 2 3 1600000000.5\nnan nan nan 1600000000.55\n4 5 6 1600000000.6\n");
+  const PointCloudFile a = read_pcd(ascii);
+  ASSERT_EQ(a.scan.points.size(), 2u);
+  EXPECT_DOUBLE_EQ(a.scan.timestamp_s, 1600000000.5);
+  EXPECT_NEAR(a.scan.points[1].time_s, 0.1f, 1e-6);
+}
+
+TEST(Pcd, ReadsFilesWrittenByOpen3D) {
+  const fs::path dir = test::scratch_dir("pcd_open3d");
+  open3d::geometry::PointCloud cloud;
+  for (int i = 0; i < 1000; ++i) {
+    cloud.points_.emplace_back(0.01 * i, -0.02 * i, 1.0 + 0.001 * i);
+    cloud.normals_.emplace_back(0, 0, 1);
+    cloud.colors_.emplace_back(0.5, 0.25, 1.0);
+  }
+  for (bool ascii : {true, false})
+    for (bool compressed : {false, true}) {
+      if (ascii && compressed) continue;
+      const fs::path path = dir / (std::string(ascii ? "a" : "b") + (compressed ? "c" : "") + ".pcd");
+      ASSERT_TRUE(open3d::io::WritePointCloud(path.string(), cloud,
+                                              open3d::io::WritePointCloudOption(ascii, compressed)));
+      const PointCloudFile f = read_pcd(path);
+      ASSERT_EQ(f.scan.points.size(), 1000u) << path;
+      EXPECT_NEAR(f.scan.points[999].x, 9.99, 1e-5) << path;
+      EXPECT_NEAR(f.scan.points[999].y, -19.98, 1e-5) << path;
+      EXPECT_NEAR(f.scan.points[999].z, 1.999, 1e-5) << path;
+      EXPECT_GT(f.fields.size(), 3u) << path;  // normals and rgb are there, ignored
+    }
+}
+
+TEST(Pcd, OurBinaryMapIsReadByOpen3D) {
+  const fs::path path = test::scratch_dir("pcd_to_open3d") / "map.pcd";
+  write_pcd(path, sample_points(777), PcdEncoding::kBinaryCompressed);
+  open3d::geometry::PointCloud cloud;
+  ASSERT_TRUE(open3d::io::ReadPointCloud(path.string(), cloud));
+  EXPECT_EQ(cloud.points_.size(), 777u);
+}
+
+TEST(Pcd, TruncatedAndCorruptFilesGiveAnErrorNamingTheFile) {
+  const fs::path dir = test::scratch_dir("pcd_bad");
+  const auto pts = sample_points(300);
+  for (auto enc : {PcdEncoding::kAscii, PcdEncoding::kBinary, PcdEncoding::kBinaryCompressed}) {
+    const fs::path good = dir / ("good" + std::to_string(int(enc)) + ".pcd");
+    write_pcd(good, pts, enc);
+    std::ifstream in(good, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const fs::path cut = dir / ("cut" + std::to_string(int(enc)) + ".pcd");
+    write_bytes(cut, bytes.substr(0, bytes.size() - 700));
+    const std::string e = error_of(cut);
+    EXPECT_NE(e.find(cut.string()), std::string::npos) << e;
+    EXPECT_TRUE(e.find("truncated") != std::string::npos) << e;
+  }
+  // Compressed data with garbage in the middle of the LZF stream.
+  const fs::path good = dir / "good2.pcd";
+  std::ifstream in(good, std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::size_t data = bytes.find("DATA binary_compressed\n") + 23 + 8;
+  for (std::size_t i = data; i < data + 64; ++i) bytes[i] = static_cast<char>(0xff);
+  const fs::path corrupt = dir / "corrupt.pcd";
+  write_bytes(corrupt, bytes);
+  EXPECT_NE(error_of(corrupt).find("corrupt"), std::string::npos) << error_of(corrupt);
+
+  const fs::path no_xyz = dir / "noxyz.pcd";
+  write_bytes(no_xyz, "VERSION 0.7\nFIELDS a b c\nSIZE 4 4 4\nTYPE F F F\nWIDTH 1\nHEIGHT 1\nPOINTS 1\nDATA ascii\n1 2 3\n");
+  EXPECT_NE(error_of(no_xyz).find("no x, y and z"), std::string::npos) << error_of(no_xyz);
+  const fs::path text = dir / "text.pcd";
+  write_bytes(text, "hello world\n");
+  EXPECT_NE(error_of(text).find("not a PCD file"), std::string::npos) << error_of(text);
+  EXPECT_NE(error_of(dir / "missing.pcd").find("cannot open"), std::string::npos);
+}
