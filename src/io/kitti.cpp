@@ -1,6 +1,8 @@
 #include "scfloam/io/kitti.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <sstream>
@@ -131,6 +133,33 @@ PoseList camera_to_lidar_poses(const PoseList& T_cam, const Eigen::Isometry3d& T
   return out;
 }
 
+namespace {
+
+// A missing scan in the numbering is an error, not skipped: times.txt and poses.txt are
+// indexed by line, so every scan after a gap would get its neighbour's time and ground truth.
+void check_no_gaps(const std::vector<fs::path>& sorted_scans) {
+  long long previous = -1;
+  for (const auto& path : sorted_scans) {
+    const std::string stem = path.stem().string();
+    if (stem.empty() || stem.size() > 12 ||
+        stem.find_first_not_of("0123456789") != std::string::npos)
+      return;  // not KITTI's numbering: nothing to check
+    const long long number = std::stoll(stem);
+    if (previous >= 0 && number != previous + 1) {
+      char missing[32];
+      std::snprintf(missing, sizeof missing, "%0*lld.bin", static_cast<int>(stem.size()),
+                    previous + 1);
+      throw file_error(path.parent_path() / missing,
+                       "missing: the scans jump from " + std::to_string(previous) + " to " +
+                           std::to_string(number) +
+                           " (times.txt and poses.txt lines would no longer match the scans)");
+    }
+    previous = number;
+  }
+}
+
+}  // namespace
+
 KittiSequence KittiSequence::open(const fs::path& dir) {
   if (!fs::exists(dir)) throw file_error(dir, "no such directory");
   if (!fs::is_directory(dir)) throw file_error(dir, "not a directory (expected a KITTI sequence)");
@@ -144,6 +173,7 @@ KittiSequence KittiSequence::open(const fs::path& dir) {
   }
   if (seq.scan_paths_.empty()) throw file_error(velodyne, "no .bin scans in the folder");
   std::sort(seq.scan_paths_.begin(), seq.scan_paths_.end());
+  check_no_gaps(seq.scan_paths_);
 
   const fs::path calib = dir / "calib.txt";
   if (!fs::exists(calib)) throw file_error(calib, "missing (needed for the velodyne->camera `Tr`)");
