@@ -113,8 +113,6 @@ std::vector<Binding> bindings(SlamConfig& c) {
       {pg, "loop_outlier_chi2", &g.loop_outlier_chi2},
       {pg, "max_outlier_rounds", &g.max_outlier_rounds},
       {pg, "max_iterations", &g.max_iterations},
-      {pg, "estimate_odometry_drift", &g.estimate_odometry_drift},
-      {pg, "odometry_drift_prior_deg_per_100m", &g.odometry_drift_prior_deg_per_100m},
   });
   auto& p = c.pipeline;
   const std::string pl = "pipeline";
