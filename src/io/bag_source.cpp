@@ -200,7 +200,12 @@ InputInfo inspect_bag(const fs::path& path, const ScanSourceOptions& options) {
     const Scan scan = pointcloud2_to_scan(first, path.string() + ": topic " + topic + " message 0");
     info.points_in_first_scan = scan.points.size();
     if (!scan.has_ring) info.notes.push_back("no ring field (rings are computed from elevation)");
-    if (!scan.has_time) info.notes.push_back("no per-point time field (no deskew from the source)");
+    const std::string time_field = point_time_field(first.fields);
+    if (!scan.has_time)
+      info.notes.push_back(time_field.empty()
+                               ? "no per-point time field (no deskew from the source)"
+                               : "per-point time field '" + time_field +
+                                     "' ignored: its values are not times within 1.5 s of the stamp");
     if (scan.points.size() < first.width * std::size_t{first.height})
       info.notes.push_back("first scan: " + std::to_string(first.width * std::size_t{first.height} - scan.points.size()) +
                            " points with NaN coordinates dropped");

@@ -47,11 +47,20 @@ double read_value(const std::uint8_t* p, std::uint8_t datatype, bool swap) {
   return std::numeric_limits<double>::quiet_NaN();
 }
 
-const PointField* find_field(const PointCloud2View& cloud, std::initializer_list<const char*> names) {
+const PointField* find_field(const std::vector<PointField>& fields,
+                             std::initializer_list<const char*> names) {
   for (const char* name : names)
-    for (const PointField& f : cloud.fields)
+    for (const PointField& f : fields)
       if (f.name == name) return &f;
   return nullptr;
+}
+
+const PointField* find_field(const PointCloud2View& cloud, std::initializer_list<const char*> names) {
+  return find_field(cloud.fields, names);
+}
+
+const PointField* find_time_field(const std::vector<PointField>& fields) {
+  return find_field(fields, {"time", "t", "time_offset", "offset_time", "timestamp", "ts"});
 }
 
 void check_field(const PointCloud2View& cloud, const PointField* f, const std::string& where) {
@@ -68,6 +77,42 @@ void check_field(const PointCloud2View& cloud, const PointField* f, const std::s
 
 bool is_integer_type(std::uint8_t datatype) {
   return datatype >= 1 && datatype <= 6;
+}
+
+
+// How per-point times become seconds relative to the stamp: t * scale - subtract_s.
+struct TimeRule {
+  bool valid = false;
+  double scale = 1, subtract_s = 0;
+};
+
+// Drivers disagree on the time field: Velodyne `time` is float seconds relative to the stamp,
+// Ouster `t` / Livox `offset_time` uint32 relative nanoseconds, Hesai / RoboSense `timestamp`
+// float64 absolute seconds, livox_ros_driver2 `timestamp` float64 absolute nanoseconds. The
+// first reading in this order that puts every point of the cloud within kMaxScanSpan of the
+// stamp wins (integers are only read as relative nanoseconds); none -> no per-point time.
+TimeRule choose_time_rule(const PointCloud2View& cloud, const PointField& ft, bool swap) {
+  constexpr double kMaxScanSpan = 1.5;  // seconds: slower than any spinning LiDAR's sweep
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (std::size_t r = 0; r < cloud.height; ++r)
+    for (std::size_t c = 0; c < cloud.width; ++c) {
+      const double t = read_value(cloud.data + r * cloud.row_step + c * cloud.point_step + ft.offset,
+                                  ft.datatype, swap);
+      if (!std::isfinite(t)) continue;
+      lo = std::min(lo, t);
+      hi = std::max(hi, t);
+    }
+  if (lo > hi) return {};
+  const double stamp = cloud.stamp_s();
+  const bool integer = is_integer_type(ft.datatype);
+  const TimeRule candidates[] = {{!integer, 1, 0}, {!integer, 1, stamp}, {!integer, 1e-9, stamp},
+                                 {true, 1e-9, 0}};
+  for (const TimeRule& rule : candidates) {
+    if (!rule.valid) continue;
+    const double a = lo * rule.scale - rule.subtract_s, b = hi * rule.scale - rule.subtract_s;
+    if (std::fabs(a) <= kMaxScanSpan && std::fabs(b) <= kMaxScanSpan) return rule;
+  }
+  return {};
 }
 
 }  // namespace
@@ -87,6 +132,11 @@ std::string point_field_type_name(std::uint8_t datatype) {
                                 "int32", "uint32", "float32", "float64"};
   if (datatype >= 1 && datatype <= 8) return names[datatype];
   return "type" + std::to_string(datatype);
+}
+
+std::string point_time_field(const std::vector<PointField>& fields) {
+  const PointField* f = find_time_field(fields);
+  return f ? f->name : std::string();
 }
 
 std::vector<std::string> describe_point_fields(const std::vector<PointField>& fields) {
@@ -111,8 +161,7 @@ Scan pointcloud2_to_scan(const PointCloud2View& cloud, const std::string& where)
   }
   const PointField* fi = find_field(cloud, {"intensity", "reflectivity", "i"});
   const PointField* fr = find_field(cloud, {"ring", "channel", "laser_id", "line"});
-  const PointField* ft =
-      find_field(cloud, {"time", "t", "time_offset", "offset_time", "timestamp", "ts"});
+  const PointField* ft = find_time_field(cloud.fields);
   for (const PointField* f : {fx, fy, fz, fi, fr, ft}) check_field(cloud, f, where);
 
   const std::size_t width = cloud.width, height = cloud.height;
@@ -134,15 +183,11 @@ Scan pointcloud2_to_scan(const PointCloud2View& cloud, const std::string& where)
   Scan scan;
   scan.timestamp_s = cloud.stamp_s();
   scan.has_ring = fr != nullptr;
-  scan.has_time = ft != nullptr;
   scan.points.reserve(width * height);
   const bool swap = cloud.is_bigendian == host_is_little_endian();
 
-  // Per-point time, decided once per cloud from the first finite value: integers are
-  // relative nanoseconds (Ouster `t`, Livox `offset_time`); floats above 1e6 are absolute
-  // seconds (Hesai/Livox `timestamp`: subtract the stamp); other floats are relative seconds.
-  enum class TimeKind { Unknown, RelativeNs, RelativeS, AbsoluteS } time_kind = TimeKind::Unknown;
-  if (ft && is_integer_type(ft->datatype)) time_kind = TimeKind::RelativeNs;
+  const TimeRule time_rule = ft ? choose_time_rule(cloud, *ft, swap) : TimeRule{};
+  scan.has_time = time_rule.valid;
 
   for (std::size_t r = 0; r < height; ++r) {
     const std::uint8_t* row = cloud.data + r * row_step;
@@ -158,15 +203,9 @@ Scan pointcloud2_to_scan(const PointCloud2View& cloud, const std::string& where)
       pt.z = static_cast<float>(z);
       if (fi) pt.intensity = static_cast<float>(read_value(p + fi->offset, fi->datatype, swap));
       if (fr) pt.ring = static_cast<std::int16_t>(read_value(p + fr->offset, fr->datatype, swap));
-      if (ft) {
+      if (time_rule.valid) {
         const double t = read_value(p + ft->offset, ft->datatype, swap);
-        if (time_kind == TimeKind::Unknown && std::isfinite(t))
-          time_kind = std::fabs(t) > 1e6 ? TimeKind::AbsoluteS : TimeKind::RelativeS;
-        switch (time_kind) {
-          case TimeKind::RelativeNs: pt.time_s = static_cast<float>(t * 1e-9); break;
-          case TimeKind::AbsoluteS: pt.time_s = static_cast<float>(t - scan.timestamp_s); break;
-          default: pt.time_s = static_cast<float>(t); break;
-        }
+        pt.time_s = static_cast<float>(t * time_rule.scale - time_rule.subtract_s);
         if (!std::isfinite(pt.time_s)) pt.time_s = 0;
       }
       scan.points.push_back(pt);

@@ -49,35 +49,37 @@ void expect_scan(const Scan& s, const std::vector<LidarPoint>& pts, double stamp
 constexpr int kFrames = 5;
 double stamp_of(int i) { return 1700000000.0 + 0.1 * i + 0.000123; }
 
+// ROS 1 bag through librosbag's writer (LZ4 chunks), messages built by ROS's sensor_msgs.
+void write_ros1_bag(const std::filesystem::path& path, const std::vector<std::string>& topics) {
+  rosbag::Bag bag(path.string(), rosbag::bagmode::Write);
+  bag.setCompression(rosbag::compression::LZ4);
+  for (int i = 0; i < kFrames; ++i) {
+    const test::OwnedCloud c = test::make_cloud(ring_scan(i), stamp_of(i), {});
+    sensor_msgs::PointCloud2 msg;
+    msg.header.stamp = ros::Time(static_cast<std::uint32_t>(c.meta.stamp_sec), c.meta.stamp_nanosec);
+    msg.header.frame_id = c.meta.frame_id;
+    msg.height = c.meta.height;
+    msg.width = c.meta.width;
+    for (const PointField& f : c.meta.fields) {
+      sensor_msgs::PointField pf;
+      pf.name = f.name;
+      pf.offset = f.offset;
+      pf.datatype = f.datatype;
+      pf.count = f.count;
+      msg.fields.push_back(pf);
+    }
+    msg.point_step = c.meta.point_step;
+    msg.row_step = c.meta.row_step;
+    msg.data = c.data;
+    msg.is_dense = true;
+    for (const auto& topic : topics) bag.write(topic, msg.header.stamp, msg);
+  }
+}
+
 TEST(BagRoundTrip, Ros1ThroughLibrosbagWriter) {
   const auto dir = test::scratch_dir("bag_ros1");
   const auto path = dir / "scans.bag";
-  {
-    rosbag::Bag bag(path.string(), rosbag::bagmode::Write);
-    bag.setCompression(rosbag::compression::LZ4);
-    for (int i = 0; i < kFrames; ++i) {
-      const test::OwnedCloud c = test::make_cloud(ring_scan(i), stamp_of(i), {});
-      sensor_msgs::PointCloud2 msg;
-      msg.header.stamp = ros::Time(static_cast<std::uint32_t>(c.meta.stamp_sec), c.meta.stamp_nanosec);
-      msg.header.frame_id = c.meta.frame_id;
-      msg.height = c.meta.height;
-      msg.width = c.meta.width;
-      for (const PointField& f : c.meta.fields) {
-        sensor_msgs::PointField pf;
-        pf.name = f.name;
-        pf.offset = f.offset;
-        pf.datatype = f.datatype;
-        pf.count = f.count;
-        msg.fields.push_back(pf);
-      }
-      msg.point_step = c.meta.point_step;
-      msg.row_step = c.meta.row_step;
-      msg.data = c.data;
-      msg.is_dense = true;
-      bag.write("/velodyne_points", msg.header.stamp, msg);
-      bag.write("/other_points", msg.header.stamp, msg);
-    }
-  }
+  write_ros1_bag(path, {"/velodyne_points", "/other_points"});
   ASSERT_TRUE(is_bag_input(path));
   // Two PointCloud2 topics: the error lists them; --topic picks one.
   try {
@@ -168,7 +170,8 @@ TEST(BagRoundTrip, ConcurrentLoadsOfDistinctIndices) {
   std::vector<std::pair<std::int64_t, std::vector<std::uint8_t>>> msgs;
   for (int i = 0; i < kFrames; ++i) msgs.push_back({static_cast<std::int64_t>(stamp_of(i) * 1e9), cloud_bytes(i)});
   test::write_sqlite_bag(dir / "t.db3", "/points", "cdr", msgs, true);
-  for (const char* name : {"t.mcap", "t.db3"}) {
+  write_ros1_bag(dir / "t.bag", {"/points"});
+  for (const char* name : {"t.mcap", "t.db3", "t.bag"}) {
     const auto source = open_bag_source(dir / name, {});
     std::vector<Scan> scans(kFrames);
     std::vector<std::thread> threads;

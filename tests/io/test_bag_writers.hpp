@@ -22,7 +22,7 @@
 
 namespace scfloam::test {
 
-enum class TimeField { None, RelativeSecondsF32, RelativeNanosU32, AbsoluteSecondsF64 };
+enum class TimeField { None, RelativeSecondsF32, RelativeNanosU32, AbsoluteSecondsF64, AbsoluteNanosF64 };
 
 struct CloudLayout {
   std::uint8_t xyz_type = 7;   // FLOAT32
@@ -74,7 +74,7 @@ inline OwnedCloud make_cloud(const std::vector<LidarPoint>& pts, double stamp_s,
   if (L.ring) add("ring", 4);
   if (L.time == TimeField::RelativeSecondsF32) add("time", 7);
   if (L.time == TimeField::RelativeNanosU32) add("t", 6);
-  if (L.time == TimeField::AbsoluteSecondsF64) add("timestamp", 8);
+  if (L.time == TimeField::AbsoluteSecondsF64 || L.time == TimeField::AbsoluteNanosF64) add("timestamp", 8);
   c.meta.point_step = off + L.padding;
   c.meta.height = L.height;
   c.meta.width = static_cast<std::uint32_t>((pts.size() + L.height - 1) / L.height);
@@ -97,7 +97,7 @@ inline OwnedCloud make_cloud(const std::vector<LidarPoint>& pts, double stamp_s,
       else if (f.name == "ring") v = q.ring;
       else if (f.name == "time") v = q.time_s;
       else if (f.name == "t") v = std::llround(static_cast<double>(q.time_s) * 1e9);
-      else if (f.name == "timestamp") v = stamp_s + q.time_s;
+      else if (f.name == "timestamp") v = L.time == TimeField::AbsoluteNanosF64 ? (stamp_s + q.time_s) * 1e9 : stamp_s + q.time_s;
       put_value(p + f.offset, f.datatype, v, L.big_endian);
     }
   }

@@ -104,6 +104,20 @@ TEST(PointCloud2, TimeFieldConventions) {
   // ~0.2 us at 1.6e9 s).
   L.time = test::TimeField::AbsoluteSecondsF64;
   expect_points(round_trip(pts, 1.6e9 + 0.25, L, false), pts, L, 1e-6);
+  // Absolute float64 nanoseconds (livox_ros_driver2): 1.6e18 ns holds ~0.3 us.
+  L.time = test::TimeField::AbsoluteNanosF64;
+  expect_points(round_trip(pts, 1.6e9 + 0.25, L, false), pts, L, 1e-6);
+  // Relative seconds on a small simulated stamp stay relative.
+  L.time = test::TimeField::RelativeSecondsF32;
+  expect_points(round_trip(pts, 0.05, L, false), pts, L, 1e-7);
+  // Absolute seconds that are 100 s away from the stamp are not understood: no time.
+  L.time = test::TimeField::AbsoluteSecondsF64;
+  test::OwnedCloud c = test::make_cloud(pts, 1.6e9, L);
+  c.meta.stamp_sec += 100;
+  const auto bytes = test::encode_cdr(c, false);
+  const Scan s = pointcloud2_to_scan(decode_cdr_pointcloud2(bytes.data(), bytes.size(), "w"), "w");
+  EXPECT_FALSE(s.has_time);
+  for (const LidarPoint& p : s.points) EXPECT_EQ(p.time_s, 0.f);
 }
 
 TEST(PointCloud2, BadCloudsAreErrors) {

@@ -47,6 +47,9 @@ std::string point_field_type_name(std::uint8_t datatype);
 // "x:float32", "ring:uint16", "rgb:float32[3]" for `scfloam info`.
 std::vector<std::string> describe_point_fields(const std::vector<PointField>& fields);
 
+// Name of the field read as per-point time (see pointcloud2_to_scan), empty when none.
+std::string point_time_field(const std::vector<PointField>& fields);
+
 // Decoders of the two wire formats. `where` names the file, topic and message index for errors.
 PointCloud2View decode_ros1_pointcloud2(const std::uint8_t* bytes, std::size_t size,
                                         const std::string& where);
