@@ -60,6 +60,9 @@ struct RegistrationConfig {
   // Stop the rounds early once one moves the pose less than both of these.
   double converged_translation_m = 0.001;
   double converged_rotation_deg = 0.01;
+  // Inside a round, Ceres stops once an accepted step's tangent norm |[omega; v]| (rad, m) is
+  // below this (0 = always run inner_iterations).
+  double solver_step_tolerance = 1e-4;
   // Smallest eigenvalue of the translation block of J^T J (in units of "well-constrained
   // residuals") below which a solve is reported degenerate.
   double degeneracy_min_eigenvalue = 50.0;
@@ -95,6 +98,10 @@ struct PipelineConfig {
   bool deterministic = false;
   int queue_capacity = 256;        // keyframes waiting between stages
   bool rebuild_map_after_loop = true;  // the odometry continues on the corrected map
+  // A correction that moves no keyframe near the odometry by more than this (relative to the
+  // newest keyframe; rotation counted at 30 m) leaves the map as it is, unless the odometry
+  // travelled a fifth of the map radius since the last rebuild. 0: rebuild after every loop.
+  double map_rebuild_min_shift_m = 0.05;
   double raw_leaf_m = 0.4;         // raw keyframe clouds (baseline descriptor, ICP) downsampling
 };
 

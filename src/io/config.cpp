@@ -55,6 +55,7 @@ std::vector<Binding> bindings(SlamConfig& c) {
       {reg, "match_refresh_m", &o.registration.match_refresh_m},
       {reg, "converged_translation_m", &o.registration.converged_translation_m},
       {reg, "converged_rotation_deg", &o.registration.converged_rotation_deg},
+      {reg, "solver_step_tolerance", &o.registration.solver_step_tolerance},
       {reg, "degeneracy_min_eigenvalue", &o.registration.degeneracy_min_eigenvalue},
       {reg, "degeneracy_min_rotation_eigenvalue",
        &o.registration.degeneracy_min_rotation_eigenvalue},
@@ -120,6 +121,7 @@ std::vector<Binding> bindings(SlamConfig& c) {
       {pl, "deterministic", &p.deterministic},
       {pl, "queue_capacity", &p.queue_capacity},
       {pl, "rebuild_map_after_loop", &p.rebuild_map_after_loop},
+      {pl, "map_rebuild_min_shift_m", &p.map_rebuild_min_shift_m},
       {pl, "raw_leaf_m", &p.raw_leaf_m},
   });
   return table;
