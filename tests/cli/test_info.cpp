@@ -1,0 +1,78 @@
+// `scfloam info`: text and JSON reports, and a clear error for a file it cannot read.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "scfloam/io/point_cloud_file.hpp"
+#include "test_paths.hpp"
+
+namespace fs = std::filesystem;
+using namespace scfloam;
+
+namespace {
+
+struct Outcome {
+  int exit_code = -1;
+  std::string output;
+};
+
+Outcome run_cli(const std::string& args) {
+  const std::string cmd = std::string(SCFLOAM_BINARY_DIR) + "/bin/scfloam " + args + " 2>&1";
+  Outcome out;
+  FILE* pipe = popen(cmd.c_str(), "r");
+  if (!pipe) return out;
+  char buf[4096];
+  while (std::fgets(buf, sizeof buf, pipe)) out.output += buf;
+  const int status = pclose(pipe);
+  out.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return out;
+}
+
+}  // namespace
+
+TEST(CliInfo, PcdFolderTextAndJson) {
+  const fs::path dir = test::scratch_dir("cli_info");
+  std::vector<LidarPoint> pts(50);
+  for (std::size_t i = 0; i < pts.size(); ++i) pts[i].x = static_cast<float>(i);
+  for (int i = 0; i < 3; ++i) write_pcd(dir / ("s" + std::to_string(i) + ".pcd"), pts, PcdEncoding::kBinary, true);
+  Outcome r = run_cli("info " + dir.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  for (const char* expected : {"PCD folder", "scans:     3", "ring:uint16", "time:float32",
+                               "points in the first scan: 50", "0.1 s apart"})
+    EXPECT_NE(r.output.find(expected), std::string::npos) << expected << " in\n" << r.output;
+
+  r = run_cli("info --json " + dir.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto j = nlohmann::json::parse(r.output);
+  EXPECT_EQ(j["scans"], 3);
+  EXPECT_EQ(j["points_in_first_scan"], 50);
+  EXPECT_EQ(j["point_fields"].size(), 6u);
+  EXPECT_EQ(j["point_fields"][0], "x:float32");
+  EXPECT_DOUBLE_EQ(j["end_time_s"].get<double>(), 0.2);
+  EXPECT_TRUE(j["notes"].is_array());
+  EXPECT_TRUE(j["topics"].is_array());
+}
+
+TEST(CliInfo, KittiSequence) {
+  SCFLOAM_SHARED_DATA_OR_SKIP(seq, "kitti/scans/00");
+  const Outcome r = run_cli("info --json " + seq.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto j = nlohmann::json::parse(r.output);
+  EXPECT_EQ(j["kind"], "KITTI sequence");
+  EXPECT_EQ(j["scans"], 10);
+  EXPECT_GT(j["points_in_first_scan"].get<int>(), 100000);
+}
+
+TEST(CliInfo, UnreadableInputsSayWhyAndExitNonZero) {
+  const fs::path dir = test::scratch_dir("cli_info_bad");
+  { std::ofstream(dir / "cut.ply", std::ios::binary) << "ply\nformat binary_little_endian 1.0\nelement vertex 9\nproperty float x\nproperty float y\nproperty float z\nend_header\nabc"; }
+  Outcome r = run_cli("info " + (dir / "cut.ply").string());
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.output.find("cut.ply"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("truncated"), std::string::npos) << r.output;
+  r = run_cli("info " + (dir / "absent").string());
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.output.find("no such file"), std::string::npos) << r.output;
+}

@@ -1,0 +1,158 @@
+// `scfloam run` on a folder of PCD scans: same trajectory as the same scans as a KITTI
+// directory, the map files (PCD, PLY, keyframes), --frame, --force, --sensor.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "scfloam/io/kitti.hpp"
+#include "scfloam/io/point_cloud_file.hpp"
+#include "scfloam/io/trajectory.hpp"
+#include "scfloam/sim/simulate.hpp"
+#include "test_paths.hpp"
+
+namespace fs = std::filesystem;
+using namespace scfloam;
+
+namespace {
+
+struct Outcome {
+  int exit_code = -1;
+  std::string output;
+};
+
+Outcome run_cli(const std::string& args) {
+  const std::string cmd = std::string(SCFLOAM_BINARY_DIR) + "/bin/scfloam " + args + " 2>&1";
+  Outcome out;
+  FILE* pipe = popen(cmd.c_str(), "r");
+  if (!pipe) return out;
+  char buf[4096];
+  while (std::fgets(buf, sizeof buf, pipe)) out.output += buf;
+  const int status = pclose(pipe);
+  out.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return out;
+}
+
+// 30 simulated HDL-64 scans as a KITTI directory and the same scans as binary_compressed PCDs
+// with a timestamps file (built once for the suite).
+class RunOutputs : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    root_ = test::scratch_dir("run_outputs");
+    sim::SimConfig cfg;
+    cfg.frames = 30;
+    cfg.seed = 4;
+    sim::simulate_sequence(cfg, root_ / "kitti", false);
+    const KittiSequence seq = KittiSequence::open(root_ / "kitti");
+    fs::create_directories(root_ / "pcd");
+    for (std::size_t i = 0; i < seq.size(); ++i)
+      write_pcd(root_ / "pcd" / ("scan" + std::to_string(i) + ".pcd"), seq.load(i).points,
+                PcdEncoding::kBinaryCompressed);
+    fs::copy_file(root_ / "kitti" / "times.txt", root_ / "stamps.txt");
+  }
+  static fs::path root_;
+};
+fs::path RunOutputs::root_;
+
+}  // namespace
+
+TEST_F(RunOutputs, PcdFolderGivesTheSameTrajectoryAsTheKittiDirectory) {
+  const std::string common = " --mode odometry --deterministic --quiet --frame lidar";
+  Outcome a = run_cli("run " + (root_ / "kitti").string() + " -o " + (root_ / "out_kitti").string() + common);
+  ASSERT_EQ(a.exit_code, 0) << a.output;
+  Outcome b = run_cli("run " + (root_ / "pcd").string() + " --timestamps " + (root_ / "stamps.txt").string() +
+                      " -o " + (root_ / "out_pcd").string() + common);
+  ASSERT_EQ(b.exit_code, 0) << b.output;
+  const auto ta = read_tum(root_ / "out_kitti" / "poses_tum.txt");
+  const auto tb = read_tum(root_ / "out_pcd" / "poses_tum.txt");
+  ASSERT_EQ(ta.poses.size(), 30u);
+  ASSERT_EQ(tb.poses.size(), 30u);
+  double max_diff_m = 0;
+  for (std::size_t i = 0; i < 30; ++i) {
+    EXPECT_DOUBLE_EQ(ta.stamps_s[i], tb.stamps_s[i]);
+    max_diff_m = std::max(max_diff_m, (ta.poses[i].translation() - tb.poses[i].translation()).norm());
+  }
+  // The same float32 points in the same order: the same trajectory (to the file's digits).
+  EXPECT_LT(max_diff_m, 1e-6);
+  EXPECT_GT(ta.poses.back().translation().norm(), 5.0);  // it moved
+}
+
+TEST_F(RunOutputs, MapPlyKeyframesFrameAndForce) {
+  const fs::path out = root_ / "nested" / "out_maps";  // parent folders are created
+  const std::string input = (root_ / "pcd").string();
+  Outcome r = run_cli("run " + input + " -o " + out.string() +
+                      " --mode odometry --quiet -n 12 --ply --save-keyframes --map-voxel 0.5");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const PointCloudFile pcd = read_pcd(out / "map.pcd");
+  const PointCloudFile ply = read_ply(out / "map.ply");
+  EXPECT_EQ(ply.format, "PLY binary_little_endian");
+  ASSERT_GT(pcd.scan.points.size(), 1000u);
+  ASSERT_EQ(ply.scan.points.size(), pcd.scan.points.size());
+  std::size_t with_intensity = 0;
+  for (std::size_t i = 0; i < ply.scan.points.size(); ++i) {
+    EXPECT_EQ(ply.scan.points[i].x, pcd.scan.points[i].x);
+    with_intensity += ply.scan.points[i].intensity > 0.05f;
+  }
+  EXPECT_GT(with_intensity, ply.scan.points.size() / 2);  // simulated reflectance is kept
+  // keyframes/: one cloud per keyframe and their poses; rebuilding gives the map's extent.
+  const PoseList kf_poses = read_kitti_poses(out / "keyframes" / "poses_kitti.txt");
+  ASSERT_GE(kf_poses.size(), 2u);
+  EXPECT_EQ(kf_poses.size(), read_kitti_poses(out / "keyframes_kitti.txt").size());
+  for (std::size_t k = 0; k < kf_poses.size(); ++k) {
+    char name[32];
+    std::snprintf(name, sizeof name, "%06zu.pcd", k);
+    EXPECT_TRUE(fs::exists(out / "keyframes" / name)) << name;
+  }
+  const PointCloudFile last = read_pcd(out / "keyframes" / "000001.pcd");
+  const Eigen::Vector3f p(last.scan.points[0].x, last.scan.points[0].y, last.scan.points[0].z);
+  const Eigen::Vector3f world = kf_poses[1].cast<float>() * p;
+  float nearest = 1e9f;
+  for (const auto& q : pcd.scan.points) nearest = std::min(nearest, (Eigen::Vector3f(q.x, q.y, q.z) - world).norm());
+  EXPECT_LT(nearest, 1.0f);  // a keyframe point moved by its pose lies on the map (0.5 m voxels)
+
+  // An existing result is refused without --force; with it the run goes ahead.
+  r = run_cli("run " + input + " -o " + out.string() + " --mode odometry --quiet -n 3");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.output.find("--force"), std::string::npos) << r.output;
+  EXPECT_EQ(read_kitti_poses(out / "poses_kitti.txt").size(), 12u);  // untouched
+  r = run_cli("run " + input + " -o " + out.string() + " --mode odometry --quiet -n 3 --force");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(read_kitti_poses(out / "poses_kitti.txt").size(), 3u);
+
+  // --frame camera needs Tr: the PCD folder has none (refused before running); KITTI has one.
+  r = run_cli("run " + input + " -o " + (root_ / "cam").string() + " --mode odometry --quiet -n 3 --frame camera");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.output.find("--frame camera"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("Tr"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(root_ / "cam" / "summary.json"));
+  r = run_cli("run " + (root_ / "kitti").string() + " -o " + (root_ / "cam2").string() +
+              " --mode odometry --quiet -n 3 --frame camera");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  r = run_cli("run " + input + " -o " + (root_ / "f").string() + " --quiet -n 3 --frame sideways");
+  EXPECT_EQ(r.exit_code, 1);
+}
+
+TEST_F(RunOutputs, SensorPresetsLoadAndLivoxSaysWhyNot) {
+  for (const char* sensor : {"hdl64", "hdl32", "vlp16", "os1-64", "os1-128"}) {
+    const Outcome r = run_cli("run " + (root_ / "pcd").string() + " -o " + (root_ / "preset" / sensor).string() +
+                              " --mode odometry --quiet -n 2 --sensor " + sensor);
+    EXPECT_EQ(r.exit_code, 0) << sensor << ": " << r.output;
+  }
+  Outcome r = run_cli("run " + (root_ / "pcd").string() + " -o " + (root_ / "lv").string() + " --sensor livox");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.output.find("ring"), std::string::npos) << r.output;
+  r = run_cli("run " + (root_ / "pcd").string() + " -o " + (root_ / "xx").string() + " --sensor hdl99");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.output.find("hdl99"), std::string::npos) << r.output;
+  // --config on top of a preset: its keys are checked and its errors name it.
+  { std::ofstream(root_ / "bad.yaml") << "odometry:\n  preprocess:\n    max_range_mm: 5\n"; }
+  r = run_cli("run " + (root_ / "pcd").string() + " -o " + (root_ / "bc").string() +
+              " --sensor vlp16 --config " + (root_ / "bad.yaml").string());
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.output.find("bad.yaml"), std::string::npos) << r.output;
+  { std::ofstream(root_ / "ok.yaml") << "odometry:\n  preprocess:\n    max_range_m: 60\n"; }
+  r = run_cli("run " + (root_ / "pcd").string() + " -o " + (root_ / "okc").string() +
+              " --mode odometry --quiet -n 2 --sensor vlp16 --config " + (root_ / "ok.yaml").string());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+}
