@@ -1,0 +1,102 @@
+#!/usr/bin/env bash
+# Fuzzes every reader: builds build-fuzz (clang, libFuzzer + ASan + UBSan) and runs each
+# fuzz/<name>_fuzz target for SECONDS_PER_TARGET seconds (default 10; CI uses 10, longer
+# sessions 300+). Seeds: fuzz/corpus/<name>/ plus samples cut at run time from ../shared/data
+# and config/. The growing corpus stays in build-fuzz/fuzz-corpus/<name>/ between runs.
+# A crash leaves its input in build-fuzz/fuzz-crashes/<name>/ and makes this script fail:
+# fix the reader and copy the input to tests/io/fuzz_regressions/<name>/ (replayed by test_io).
+# Usage: scripts/fuzz.sh [SECONDS_PER_TARGET] [TARGET...]
+set -euo pipefail
+seconds="${1:-10}"
+shift || true
+cd "$(dirname "$0")/.."
+shared="${SCFLOAM_SHARED_DIR:-$(cd .. && pwd)/shared}"
+build="${SCFLOAM_FUZZ_BUILD:-build-fuzz}"
+
+targets=("$@")
+if [ ${#targets[@]} -eq 0 ]; then
+  for f in fuzz/*_fuzz.cpp; do targets+=("$(basename "$f" _fuzz.cpp)"); done
+fi
+
+cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \
+  -DSCFLOAM_FUZZ=ON -DSCFLOAM_BUILD_TESTS=OFF -DSCFLOAM_BUILD_BENCH=OFF \
+  -DSCFLOAM_SHARED_DIR="$shared" >"$build.configure.log" 2>&1 ||
+  { cat "$build.configure.log"; exit 1; }
+cmake --build "$build" -j"$(nproc)" --target "${targets[@]/%/_fuzz}"
+
+# Real files (cut to a few KB, or the smallest bags), so that the fuzzer starts from inputs
+# the readers accept. Nothing is copied into the repository (licences: fuzz/corpus/README.md).
+seed_from_shared() {
+  local name="$1" out="$2" data="$shared/data" f i=0
+  [ -d "$data" ] || return 0
+  case "$name" in
+    kitti_bin)
+      for f in "$data"/kitti/scans/*/velodyne/000000.bin; do
+        [ -f "$f" ] || continue
+        head -c 1024 "$f" >"$out/seed-bin-$i-1k"; head -c 4096 "$f" >"$out/seed-bin-$i-4k"; i=$((i + 1))
+      done ;;
+    kitti_calib)
+      for f in "$data"/kitti/scans/*/calib.txt; do
+        [ -f "$f" ] && cp "$f" "$out/seed-calib-$i" && i=$((i + 1))
+      done ;;
+    trajectory)
+      for f in "$data"/kitti/scans/*/poses.txt "$data"/kitti/scans/*/times.txt; do
+        [ -f "$f" ] && head -n 5 "$f" >"$out/seed-traj-$i" && i=$((i + 1))
+      done ;;
+    config)
+      for f in config/*.yaml; do cp "$f" "$out/seed-$(basename "$f")"; done ;;
+    ros1_bag)
+      for f in cdcpd/rope_example_10_points_2020-02-20-16-58-46.bag \
+               cdcpd/rope_example_11_points_2020-02-26-10-26-45.bag \
+               rosbag.js/fixtures/no-messages.bag rosbag.js/fixtures/example-unsorted-chunks.bag; do
+        [ -f "$data/bags/$f" ] && cp "$data/bags/$f" "$out/seed-$(basename "$f")"
+      done ;;
+    ros2_sqlite)
+      for f in ros2-rosbag2/rosbag2_tests/resources/sqlite3/cdr_test/cdr_test_0.db3 \
+               ros2-rosbag2/ros2bag/test/resources/empty_bag/empty_bag_0.db3 \
+               ros2-rosbag2/rosbag2_py/test/resources/sqlite3/talker/talker.db3; do
+        [ -f "$data/bags/$f" ] && cp "$data/bags/$f" "$out/seed-$(basename "$f")"
+      done ;;
+    mcap)
+      for f in ros2-rosbag2/rosbag2_transport/test/resources/mcap/test_bag_for_seek/test_bag_for_seek_0.mcap \
+               ros2-rosbag2/rosbag2_tests/resources/mcap/cdr_test/cdr_test_0.mcap; do
+        [ -f "$data/bags/$f" ] && cp "$data/bags/$f" "$out/seed-$(basename "$f")"
+      done
+      # The MCAP conformance variants of one message (chunked, compressed, indexed, padded...).
+      find "$data/bags/foxglove-mcap/tests/conformance/data/OneMessage" -name '*.mcap' 2>/dev/null |
+        while read -r f; do cp "$f" "$out/seed-$(basename "$f")"; done ;;
+  esac
+}
+
+summary="$build/fuzz-summary.txt"
+printf "%-14s %8s %10s %10s %7s %7s %8s  %s\n" target seconds execs execs/s cov ft corpus result >"$summary"
+failed=0
+for name in "${targets[@]}"; do
+  corpus="$build/fuzz-corpus/$name" crashes="$build/fuzz-crashes/$name"
+  mkdir -p "$corpus" "$crashes"
+  seed_from_shared "$name" "$corpus"
+  seeds=()
+  [ -d "fuzz/corpus/$name" ] && seeds+=("fuzz/corpus/$name")
+  log="$build/fuzz-$name.log"
+  echo "fuzz: $name for ${seconds}s"
+  result=ok
+  max_len=16384
+  case "$name" in ros1_bag | ros2_sqlite | mcap) max_len=65536 ;; esac
+  # -timeout: an input taking longer than 10 s is a hang; -rss_limit_mb: a 4 GB size field
+  # that allocates is a finding, not an out-of-memory of the machine.
+  if ! "$build/bin/${name}_fuzz" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
+      -max_len="$max_len" -print_final_stats=1 -artifact_prefix="$crashes/" \
+      "$corpus" "${seeds[@]}" >"$log" 2>&1; then
+    result="CRASH (see $log and $crashes/)"
+    failed=1
+    grep -E "ERROR|SUMMARY|Test unit written" "$log" | head -n 8 || true
+  fi
+  execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -n 1)
+  cov=$(grep -oE 'cov: [0-9]+' "$log" | tail -n 1 | cut -d' ' -f2)
+  ft=$(grep -oE 'ft: [0-9]+' "$log" | tail -n 1 | cut -d' ' -f2)
+  printf "%-14s %8s %10s %10s %7s %7s %8s  %s\n" "$name" "$seconds" "${execs:-?}" \
+    "$(( ${execs:-0} / (seconds > 0 ? seconds : 1) ))" "${cov:-?}" "${ft:-?}" \
+    "$(ls "$corpus" | wc -l)" "$result" >>"$summary"
+done
+cat "$summary"
+exit $failed
