@@ -3,6 +3,7 @@
 
 #include "command_registry.hpp"
 #include "scfloam/error.hpp"
+#include "scfloam/sim/degenerate.hpp"
 #include "scfloam/sim/simulate.hpp"
 
 namespace {
@@ -27,6 +28,8 @@ void run(SimulateArgs& a) {
       cfg.traffic.leader_fraction < 0 || cfg.traffic.leader_fraction > 1 ||
       cfg.traffic.follower_fraction < 0 || cfg.traffic.follower_fraction > 1)
     throw scfloam::Error("traffic rates must be >= 0 and the leader/follower fractions within [0, 1]");
+  if (!cfg.scenario.empty() && !a.replay.empty())
+    throw scfloam::Error("--scenario builds its own scene: it cannot be combined with --kitti-poses/--replay");
   if (!a.replay.empty()) {
     if (cfg.route != "loops" && cfg.route != "kitti")
       throw scfloam::Error("--kitti-poses/--replay replays a trajectory: it cannot be combined with --route " + cfg.route);
@@ -36,7 +39,9 @@ void run(SimulateArgs& a) {
   if (cfg.route == "kitti" && cfg.replay_poses.empty())
     throw scfloam::Error("--route kitti needs --kitti-poses FILE");
   if (cfg.route == "kitti" && !a.frames_given) cfg.frames = 0;  // every pose of the file
-  if (cfg.route != "kitti" && cfg.frames < 2) throw scfloam::Error("--frames must be at least 2");
+  if (!cfg.scenario.empty() && !a.frames_given) cfg.frames = 0;  // the scene's natural length
+  if (cfg.route != "kitti" && cfg.frames < 2 && !(cfg.scenario.size() && cfg.frames == 0))
+    throw scfloam::Error("--frames must be at least 2");
   if (fs::exists(a.out)) {
     if (!fs::is_directory(a.out)) throw scfloam::file_error(a.out, "exists and is not a directory");
     if (!fs::is_empty(a.out) && !a.force)
@@ -55,6 +60,9 @@ scfloam::cli::RegisterCommand reg("simulate", [](CLI::App& app) {
   sub->add_option("--seed", args->config.seed, "World, route and noise seed")->capture_default_str();
   sub->add_option("--route", args->config.route, "loops | straight | kitti")
       ->check(CLI::IsMember({"loops", "straight", "kitti"}))->capture_default_str();
+  sub->add_option("--scenario", args->config.scenario,
+                  "A degenerate scene instead of --route (docs/degenerate.md); without --frames, its natural length")
+      ->check(CLI::IsMember(scfloam::sim::degenerate_scenario_names()));
   sub->add_option("--kitti-poses,--replay", args->replay, "Replay this KITTI poses file (camera-0) through a city built around it")
       ->check(CLI::ExistingFile);
   sub->add_option("--sensor", args->config.sensor, "hdl64 | vlp16 | hdl32 | os1-128")

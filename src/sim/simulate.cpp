@@ -9,6 +9,7 @@
 #include "scfloam/io/kitti.hpp"
 #include "scfloam/io/trajectory.hpp"
 #include "scfloam/progress.hpp"
+#include "scfloam/sim/degenerate.hpp"
 #include "scfloam/sim/scan.hpp"
 #include "scfloam/stats.hpp"
 
@@ -26,6 +27,7 @@ SensorModel sensor_for(const SimConfig& config) {
 namespace {
 Scenario build_world_and_route(const SimConfig& config) {
   const double mount = sensor_for(config).mount_height_m;
+  if (!config.scenario.empty()) return make_degenerate_scenario(config.scenario, config.seed, config.frames, mount);
   if (config.route == "loops") return make_loops_scenario(config.seed, config.frames, mount);
   if (config.route == "straight") return make_straight_scenario(config.seed, config.frames, mount);
   if (config.route == "kitti") {
@@ -66,13 +68,14 @@ void simulate_sequence(const SimConfig& config, const fs::path& out_dir, bool pr
   std::size_t total_points = 0, movers_within_50m = 0;
   for (std::size_t k = 0; k < sc.frames; ++k) {
     SweepPoses poses;
-    const double t = k * sc.frame_period_s;
+    const double t = sc.frame_time(k);
     poses.T_world_lidar = sc.trajectory.at(t);
     poses.motion_distortion = config.motion_distortion;
     poses.T_world_lidar_start = sc.trajectory.at(t - 0.5 * sensor.sweep_period_s);
     poses.T_world_lidar_end = sc.trajectory.at(t + 0.5 * sensor.sweep_period_s);
-    const Scan scan = render_scan(sc.world, sensor, calib, poses, config.seed, k,
-                                  config.traffic.enabled ? &traffic : nullptr, t);
+    Scan scan = render_scan(sc.world, sensor, calib, poses, config.seed, k,
+                            config.traffic.enabled ? &traffic : nullptr, t);
+    apply_beam_losses(sc, k, sensor.beams(), &scan);
     movers_within_50m += traffic.count_near(t, poses.T_world_lidar.translation().head<2>(), 50);
     total_points += scan.points.size();
     char name[32];
@@ -89,7 +92,7 @@ void simulate_sequence(const SimConfig& config, const fs::path& out_dir, bool pr
   write_file_atomic(out_dir / "times.txt", [&](std::ostream& out) {
     char buf[32];
     for (std::size_t k = 0; k < sc.frames; ++k) {
-      std::snprintf(buf, sizeof buf, "%e\n", k * sc.frame_period_s);
+      std::snprintf(buf, sizeof buf, "%e\n", sc.frame_time(k));
       out << buf;
     }
   });
@@ -99,6 +102,9 @@ void simulate_sequence(const SimConfig& config, const fs::path& out_dir, bool pr
     out << "seed: " << config.seed << "\n";
     out << "frames: " << sc.frames << "\n";
     out << "route: " << config.route << "\n";
+    if (!config.scenario.empty())
+      out << "scenario: " << config.scenario << "\ndegenerate_frames: [" << sc.degenerate_first_frame << ", "
+          << sc.degenerate_end_frame << "]  # [first, end)\n";
     if (config.route == "kitti") out << "replay_poses: \"" << config.replay_poses.string() << "\"\n";
     out << "description: \"" << sc.description << "\"\n";
     out << "route_length_m: " << sc.route_length_m << "\n";

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "scfloam/sim/city.hpp"
 #include "scfloam/sim/route.hpp"
@@ -11,15 +12,30 @@
 
 namespace scfloam::sim {
 
+// Rings missing from every scan of frames [first_frame, end_frame) (degenerate.hpp).
+struct BeamLoss {
+  std::size_t first_frame = 0, end_frame = 0;
+  int keep_every = 1;            // 2: only even rings remain (every other beam absent)
+  double upper_share_lost = 0;   // 0.5: the upper half of the beams (ring 0 = top) is absent
+};
+
 struct Scenario {
   World world;
-  SampledTrajectory trajectory;  // T_world_lidar; frame k is at t = k * frame_period_s
+  SampledTrajectory trajectory;  // T_world_lidar; frame k is at t = frame_time(k)
   std::size_t frames = 0;
   double frame_period_s = 0.1;
   double route_length_m = 0;
   CityStats stats;
   std::string description;  // one line: what route and world this is
-  Pose frame_pose(std::size_t k) const { return trajectory.at(k * frame_period_s); }
+  // Faults of the degenerate scenes (degenerate.hpp); every other route leaves them empty.
+  std::vector<double> frame_times_s;  // frame k's time (empty: k * frame_period_s)
+  std::vector<BeamLoss> beam_losses;
+  // [first, end): the frames where the scene is degenerate (0, 0: none).
+  std::size_t degenerate_first_frame = 0, degenerate_end_frame = 0;
+  double frame_time(std::size_t k) const {
+    return frame_times_s.empty() ? k * frame_period_s : frame_times_s.at(k);
+  }
+  Pose frame_pose(std::size_t k) const { return trajectory.at(frame_time(k)); }
 };
 
 // Grid city with a route that loops: a loop around city blocks back to the start, a

@@ -21,6 +21,9 @@ struct SimConfig {
   std::uint64_t seed = 1;
   std::size_t frames = 1000;      // replay: 0 = every pose of the file
   std::string route = "loops";    // "loops", "straight" or "kitti" (replay)
+  // A degenerate scene instead of the route (degenerate.hpp: "tunnel", "gap", ...);
+  // frames = 0 then gives the scene's natural length.
+  std::string scenario;
   std::filesystem::path replay_poses;  // KITTI camera-0 poses file for route "kitti"
   std::string sensor = "hdl64";   // see sensor_preset_names()
   bool motion_distortion = false;  // KITTI's own scans are already compensated
