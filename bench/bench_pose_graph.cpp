@@ -86,6 +86,34 @@ void BM_PoseGraphAddOneLoop(benchmark::State& state) {
 }
 BENCHMARK(BM_PoseGraphAddOneLoop)->Unit(benchmark::kMillisecond);
 
+// Issue 5's question at 5000 keyframes (125 loops, the 125th arrives): the whole graph
+// re-solved from the previous solution, against a bounded window that starts at the new
+// loop's older keyframe (everything before it held fixed). Arg: 0 whole graph, 1 window.
+void BM_PoseGraph5000AddOneLoop(benchmark::State& state) {
+  const std::size_t loops = 125;
+  const Scenario s = make_scenario(5000, loops);
+  PoseGraphConfig config;
+  const bool window = state.range(0) == 1;
+  for (auto _ : state) {
+    state.PauseTiming();
+    PoseGraph graph = build_graph(s, loops - 1, config);
+    graph.optimize(config);
+    const auto [cur, old] = s.loops[loops - 1];
+    graph.add_loop_edge(cur, old, s.truth[cur].inverse() * s.truth[old], config);
+    state.ResumeTiming();
+    const PoseGraphReport r = graph.optimize(config, window ? old : 0);
+    state.counters["iterations"] = r.iterations;
+    state.PauseTiming();
+    // Accuracy of the result: mean keyframe position error against the truth.
+    double error_m = 0;
+    for (std::size_t i = 0; i < s.truth.size(); ++i)
+      error_m += (graph.pose(i).translation() - s.truth[i].translation()).norm();
+    state.counters["mean_error_m"] = error_m / s.truth.size();
+    state.ResumeTiming();
+  }
+}
+BENCHMARK(BM_PoseGraph5000AddOneLoop)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
 }  // namespace
 
 BENCHMARK_MAIN();

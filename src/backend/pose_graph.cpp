@@ -2,6 +2,8 @@
 
 #include <ceres/ceres.h>
 
+#include <algorithm>
+
 #include <cstdio>
 
 #include "backend/pose_graph_costs.hpp"
@@ -67,12 +69,12 @@ double PoseGraph::edge_chi2(std::size_t edge) const {
   return r.squaredNorm();
 }
 
-PoseGraphReport PoseGraph::optimize(const PoseGraphConfig& config) {
+PoseGraphReport PoseGraph::optimize(const PoseGraphConfig& config, std::size_t first_free_node) {
   Stopwatch watch;
   // Least squares first: a bounded kernel from the drifted start would treat a genuine first
   // loop (metres of discrepancy) as an outlier. Inconsistent loops are pruned, then the
   // Cauchy kernel polishes from the closed configuration, where true loops fit well.
-  PoseGraphReport report = solve_once(config, /*robust=*/false);
+  PoseGraphReport report = solve_once(config, /*robust=*/false, first_free_node);
   const double polish_chi2 = 0.25 * config.loop_cauchy_scale * config.loop_cauchy_scale;
   bool needs_polish = false;
   for (int round = 0; round <= config.max_outlier_rounds; ++round) {
@@ -82,7 +84,8 @@ PoseGraphReport PoseGraph::optimize(const PoseGraphConfig& config) {
     double worst_chi2 = config.loop_outlier_chi2;
     needs_polish = false;
     for (std::size_t i = 0; i < edges_.size(); ++i) {
-      if (!edges_[i].is_loop || !edges_[i].active) continue;
+      if (!edges_[i].is_loop || !edges_[i].active || !in_window(edges_[i], first_free_node))
+        continue;
       const double chi2 = edge_chi2(i);
       needs_polish |= chi2 > polish_chi2;
       if (chi2 > worst_chi2) {
@@ -93,12 +96,12 @@ PoseGraphReport PoseGraph::optimize(const PoseGraphConfig& config) {
     if (worst == edges_.size() || round == config.max_outlier_rounds) break;
     edges_[worst].active = false;
     report.rejected_edges.push_back(worst);
-    report.iterations += solve_once(config, false).iterations;
+    report.iterations += solve_once(config, false, first_free_node).iterations;
   }
   // Where every loop fits well within the kernel's scale the Cauchy solution is the
   // least-squares one to within tolerance: skip the extra solve.
   if (needs_polish) {
-    const PoseGraphReport polished = solve_once(config, true);
+    const PoseGraphReport polished = solve_once(config, true, first_free_node);
     report.iterations += polished.iterations;
     report.final_cost = polished.final_cost;
     report.converged = polished.converged;
@@ -107,7 +110,8 @@ PoseGraphReport PoseGraph::optimize(const PoseGraphConfig& config) {
   return report;
 }
 
-PoseGraphReport PoseGraph::solve_once(const PoseGraphConfig& config, bool robust) {
+PoseGraphReport PoseGraph::solve_once(const PoseGraphConfig& config, bool robust,
+                                      std::size_t first_free_node) {
   PoseGraphReport report;
   if (size() < 2 || edges_.empty()) return report;
   ceres::Problem::Options problem_options;
@@ -117,15 +121,16 @@ PoseGraphReport PoseGraph::solve_once(const PoseGraphConfig& config, bool robust
   PoseManifold manifold;
   ceres::CauchyLoss loop_loss(config.loop_cauchy_scale);
   for (const auto& e : edges_) {
-    if (!e.active) continue;
+    if (!e.active || !in_window(e, first_free_node)) continue;
     problem.AddResidualBlock(new RelativePoseCost(e.T_from_to, e.sqrt_information),
                              e.is_loop && robust ? &loop_loss : nullptr, nodes_[e.from].data(),
                              nodes_[e.to].data());
   }
   for (auto& node : nodes_)
     if (problem.HasParameterBlock(node.data())) problem.SetManifold(node.data(), &manifold);
-  // Node 0 anchors the map (gauge freedom).
-  if (problem.HasParameterBlock(nodes_[0].data())) problem.SetParameterBlockConstant(nodes_[0].data());
+  // Node 0 anchors the map (gauge freedom); a window is anchored by the nodes before it.
+  for (std::size_t i = 0; i < std::max<std::size_t>(first_free_node, 1) && i < size(); ++i)
+    if (problem.HasParameterBlock(nodes_[i].data())) problem.SetParameterBlockConstant(nodes_[i].data());
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
   options.max_num_iterations = config.max_iterations;

@@ -73,6 +73,35 @@ TEST(PoseGraph, ClosesASquareLoopWithDrift) {
   EXPECT_TRUE(fixed[0].isApprox(odom[0], 1e-12));  // node 0 is the fixed origin
 }
 
+// A bounded window: nodes before it are not moved, edges among them are left out. A loop
+// inside the window gets the whole-graph answer, since the older nodes cannot help it.
+TEST(PoseGraph, BoundedWindowHoldsTheOlderNodesAndMatchesTheWholeGraph) {
+  const PoseList truth = square_truth();
+  const PoseList odom = drifted(truth, 3e-4);
+  const std::size_t first = 50, last = odom.size() - 1;
+  const Eigen::Isometry3d T_meas = truth[last].inverse() * truth[first];
+  PoseGraphConfig config;
+  auto make_graph = [&] {
+    PoseGraph graph;
+    for (const auto& T : odom) graph.add_node(T);
+    for (std::size_t i = 1; i < odom.size(); ++i)
+      graph.add_odometry_edge(i - 1, i, odom[i - 1].inverse() * odom[i], config);
+    graph.add_loop_edge(last, first, T_meas, config);
+    return graph;
+  };
+  PoseGraph window = make_graph(), whole = make_graph();
+  window.optimize(config, first);
+  whole.optimize(config);
+  for (std::size_t i = 0; i < first; ++i) EXPECT_TRUE(window.pose(i).isApprox(odom[i], 1e-12)) << i;
+  auto gap_m = [&](const PoseGraph& g) {
+    return ((g.pose(last).inverse() * g.pose(first)).translation() - T_meas.translation()).norm();
+  };
+  const double open_m = ((odom[last].inverse() * odom[first]).translation() - T_meas.translation()).norm();
+  EXPECT_LT(gap_m(window), 0.5 * open_m);
+  for (std::size_t i = first; i <= last; ++i)
+    EXPECT_LT((window.pose(i).translation() - whole.pose(i).translation()).norm(), 1e-3) << i;
+}
+
 TEST(PoseGraph, RobustKernelLimitsAFalseLoop) {
   const PoseList truth = square_truth();
   PoseGraphConfig config;
@@ -188,3 +217,4 @@ TEST(PoseGraph, AnalyticJacobiansMatchNumericDifferentiation) {
     }
   }
 }
+

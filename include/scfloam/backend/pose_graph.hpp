@@ -55,8 +55,9 @@ class PoseGraph {
   void add_loop_edge(std::size_t from, std::size_t to, const Eigen::Isometry3d& T_from_to,
                      const PoseGraphConfig& config);
 
-  // Optimizes all nodes with node 0 held fixed (the map's origin).
-  PoseGraphReport optimize(const PoseGraphConfig& config);
+  // Optimizes all nodes with node 0 held fixed (the map's origin). With first_free_node > 0,
+  // a bounded window: nodes before it stay where they are, and edges among them are left out.
+  PoseGraphReport optimize(const PoseGraphConfig& config, std::size_t first_free_node = 0);
 
   std::size_t size() const { return nodes_.size(); }
   Eigen::Isometry3d pose(std::size_t node) const;
@@ -75,7 +76,11 @@ class PoseGraph {
   std::vector<std::array<double, 7>> nodes_;
   std::vector<PoseGraphEdge> edges_;
 
-  PoseGraphReport solve_once(const PoseGraphConfig& config, bool robust);
+  PoseGraphReport solve_once(const PoseGraphConfig& config, bool robust,
+                             std::size_t first_free_node);
+  bool in_window(const PoseGraphEdge& e, std::size_t first_free_node) const {
+    return e.from >= first_free_node || e.to >= first_free_node;
+  }
 };
 
 }  // namespace scfloam
