@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <initializer_list>
+#include <limits>
 
 #include "scfloam/error.hpp"
 
@@ -134,10 +135,34 @@ PointLayout map_point_fields(const std::vector<CloudField>& fields) {
   return layout;
 }
 
-TimeEncoding time_encoding(FieldType type, double first_value) {
-  if (type == FieldType::kFloat32 || type == FieldType::kFloat64)
-    return std::abs(first_value) > 1e6 ? TimeEncoding::kAbsoluteSeconds : TimeEncoding::kRelativeSeconds;
-  return TimeEncoding::kRelativeNanoseconds;
+bool is_integer(FieldType type) { return type != FieldType::kFloat32 && type != FieldType::kFloat64; }
+
+TimeRule choose_time_rule(const unsigned char* data, std::size_t count, std::size_t stride, const CloudField& field,
+                          bool big_endian, double stamp_s) {
+  constexpr double kMaxScanSpanS = 1.5;  // slower than any spinning LiDAR's sweep
+  const bool swap = big_endian != host_is_big_endian();
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (std::size_t i = 0; i < count; ++i) {
+    const double t = read_value(data + i * stride + field.offset, field.type, swap);
+    if (!std::isfinite(t)) continue;
+    lo = std::min(lo, t);
+    hi = std::max(hi, t);
+  }
+  if (lo > hi) return {};
+  const bool floating = !is_integer(field.type);
+  // Without a stamp (PCD, PLY) the earliest point stands for it in the absolute readings.
+  const double stamp_abs_s = stamp_s != 0 ? stamp_s : lo;
+  const double stamp_abs_ns_s = stamp_s != 0 ? stamp_s : lo * 1e-9;
+  const TimeRule candidates[] = {{floating, 1, 0, false},
+                                 {floating, 1, stamp_abs_s, stamp_s == 0},
+                                 {floating, 1e-9, stamp_abs_ns_s, stamp_s == 0},
+                                 {true, 1e-9, 0, false}};
+  for (const TimeRule& rule : candidates) {
+    if (!rule.valid) continue;
+    const double a = lo * rule.scale - rule.subtract_s, b = hi * rule.scale - rule.subtract_s;
+    if (std::fabs(a) <= kMaxScanSpanS && std::fabs(b) <= kMaxScanSpanS) return rule;
+  }
+  return {};
 }
 
 void append_points(const unsigned char* data, std::size_t count, std::size_t stride,
@@ -150,9 +175,8 @@ void append_points(const unsigned char* data, std::size_t count, std::size_t str
   const CloudField* fi = layout.intensity >= 0 ? &fields[layout.intensity] : nullptr;
   const CloudField* fr = layout.ring >= 0 ? &fields[layout.ring] : nullptr;
   const CloudField* ft = layout.time >= 0 ? &fields[layout.time] : nullptr;
-  bool time_decided = false;
-  TimeEncoding encoding = TimeEncoding::kRelativeSeconds;
-  double time_origin_s = 0;
+  const TimeRule time_rule = ft ? choose_time_rule(data, count, stride, *ft, big_endian, scan.timestamp_s) : TimeRule{};
+  if (time_rule.sets_stamp) scan.timestamp_s = time_rule.subtract_s;
   scan.points.reserve(scan.points.size() + count);
   for (std::size_t i = 0; i < count; ++i) {
     const unsigned char* p = data + i * stride;
@@ -169,27 +193,15 @@ void append_points(const unsigned char* data, std::size_t count, std::size_t str
       q.intensity = std::isfinite(v) ? static_cast<float>(v) : 0.f;
     }
     if (fr) q.ring = static_cast<std::int16_t>(std::clamp(read_value(p + fr->offset, fr->type, swap), -1.0, 32767.0));
-    if (ft) {
-      const double raw = read_value(p + ft->offset, ft->type, swap);
-      if (!time_decided && std::isfinite(raw)) {
-        encoding = time_encoding(ft->type, raw);
-        if (encoding == TimeEncoding::kAbsoluteSeconds) {
-          if (scan.timestamp_s == 0) scan.timestamp_s = raw;  // no header stamp: the first point's
-          time_origin_s = scan.timestamp_s;
-        }
-        time_decided = true;
-      }
-      switch (encoding) {
-        case TimeEncoding::kRelativeSeconds: q.time_s = static_cast<float>(raw); break;
-        case TimeEncoding::kRelativeNanoseconds: q.time_s = static_cast<float>(raw * 1e-9); break;
-        case TimeEncoding::kAbsoluteSeconds: q.time_s = static_cast<float>(raw - time_origin_s); break;
-      }
+    if (time_rule.valid) {
+      const double t = read_value(p + ft->offset, ft->type, swap);
+      q.time_s = static_cast<float>(t * time_rule.scale - time_rule.subtract_s);
       if (!std::isfinite(q.time_s)) q.time_s = 0;
     }
     scan.points.push_back(q);
   }
   scan.has_ring = fr != nullptr;
-  scan.has_time = ft != nullptr;
+  scan.has_time = time_rule.valid;
 }
 
 std::vector<std::string> describe_fields(const std::vector<CloudField>& fields) {

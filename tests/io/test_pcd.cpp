@@ -136,6 +136,19 @@ TEST(Pcd, UnusualLayoutFieldOrderPaddingFloat64Uint8CountAndNaN) {
   ASSERT_EQ(a.scan.points.size(), 2u);
   EXPECT_DOUBLE_EQ(a.scan.timestamp_s, 1600000000.5);
   EXPECT_NEAR(a.scan.points[1].time_s, 0.1f, 1e-6);
+
+  // float64 absolute nanoseconds (livox_ros_driver2), and a time field no reading fits.
+  const fs::path ns = ascii.parent_path() / "abs_ns.pcd";
+  write_bytes(ns, "VERSION 0.7\nFIELDS x y z timestamp\nSIZE 4 4 4 8\nTYPE F F F F\nWIDTH 2\nHEIGHT 1\n"
+                  "POINTS 2\nDATA ascii\n1 2 3 1600000000000000000\n4 5 6 1600000000020000000\n");
+  const PointCloudFile n = read_pcd(ns);
+  EXPECT_TRUE(n.scan.has_time);
+  EXPECT_NEAR(n.scan.timestamp_s, 1.6e9, 1e-3);
+  EXPECT_NEAR(n.scan.points[1].time_s, 0.02f, 1e-6);
+  const fs::path odd = ascii.parent_path() / "odd_time.pcd";
+  write_bytes(odd, "VERSION 0.7\nFIELDS x y z time\nSIZE 4 4 4 4\nTYPE F F F F\nWIDTH 2\nHEIGHT 1\n"
+                   "POINTS 2\nDATA ascii\n1 2 3 5\n4 5 6 5e9\n");
+  EXPECT_FALSE(read_pcd(odd).scan.has_time);  // 5 .. 5e9: no reading (s or ns) fits one sweep
 }
 
 TEST(Pcd, ReadsFilesWrittenByOpen3D) {

@@ -36,19 +36,25 @@ struct PointLayout {
 };
 PointLayout map_point_fields(const std::vector<CloudField>& fields);
 
-// Per-point time to LidarPoint::time_s (seconds relative to the scan stamp), decided once per
-// scan from the type and the first point's value (the bag readers' PointCloud2 rule too):
-//   integer types        -> nanoseconds relative to the scan (Ouster `t`, Livox offset_time)
-//   floats up to 1e6     -> seconds relative to the scan (Velodyne `time`)
-//   floats above 1e6     -> absolute seconds (Hesai/Livox `timestamp`): minus the scan stamp,
-//                           or, when the scan has none (PCD/PLY), the first point's time
-//                           becomes the scan stamp
-enum class TimeEncoding { kRelativeSeconds, kRelativeNanoseconds, kAbsoluteSeconds };
-TimeEncoding time_encoding(FieldType type, double first_value);
+// Per-point time to LidarPoint::time_s = t * scale - subtract_s (seconds relative to the scan
+// stamp): the bag readers' PointCloud2 rule. The first reading in this order that puts every
+// point within 1.5 s of the stamp wins: float relative seconds (Velodyne `time`), float
+// absolute seconds (Hesai `timestamp`), float absolute nanoseconds (livox_ros_driver2),
+// relative nanoseconds (integers: Ouster `t`, Livox `offset_time`); none -> no per-point time.
+// `stamp_s` 0 (PCD/PLY have no stamp): the earliest point's time stands for the stamp in the
+// absolute readings, and the rule then sets the scan's stamp to it (sets_stamp).
+struct TimeRule {
+  bool valid = false;
+  double scale = 1, subtract_s = 0;
+  bool sets_stamp = false;
+};
+TimeRule choose_time_rule(const unsigned char* data, std::size_t count, std::size_t stride, const CloudField& field,
+                          bool big_endian, double stamp_s);
 
 // Appends `count` points of `stride` bytes starting at `data` to `scan`, dropping points whose
 // x, y or z is not finite (organized clouds). Sets scan.has_ring / has_time when the layout has
-// those fields (every point then carries them). `big_endian` for PLY/PointCloud2 data.
+// those fields (every point then carries them; has_time only when choose_time_rule found a
+// reading). `big_endian` for PLY data.
 void append_points(const unsigned char* data, std::size_t count, std::size_t stride,
                    const std::vector<CloudField>& fields, const PointLayout& layout,
                    bool big_endian, Scan& scan);
