@@ -57,6 +57,13 @@ std::vector<std::uint8_t> decompress(const std::string& compression, const std::
                                      const std::filesystem::path& path) {
   if (uncompressed_size > kMaxChunkBytes)
     throw file_error(path, "MCAP chunk claims " + std::to_string(uncompressed_size) + " bytes");
+  // Refuse a size the compressed bytes cannot produce before allocating it (found by
+  // fuzz/mcap_fuzz: a stored chunk claiming 2 GB): stored chunks are exactly their size, and
+  // LZ4 expands at most 255:1.
+  if (compression.empty() && size != uncompressed_size)
+    throw file_error(path, "MCAP chunk size mismatch");
+  if (compression == "lz4" && uncompressed_size / 255 > size + 64)
+    throw file_error(path, "bad lz4 chunk: claims more bytes than its data can hold");
   std::vector<std::uint8_t> out(uncompressed_size);
   if (compression.empty()) {
     if (size != uncompressed_size) throw file_error(path, "MCAP chunk size mismatch");
