@@ -2,6 +2,8 @@
 // directory, the map files (PCD, PLY, keyframes), --frame, --force, --sensor.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -151,8 +153,19 @@ TEST_F(RunOutputs, SensorPresetsLoadAndLivoxSaysWhyNot) {
               " --sensor vlp16 --config " + (root_ / "bad.yaml").string());
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.output.find("bad.yaml"), std::string::npos) << r.output;
-  { std::ofstream(root_ / "ok.yaml") << "odometry:\n  preprocess:\n    max_range_m: 60\n"; }
+  // The file's keys override the preset's: the map crop follows max_range_m (preset: 90 m).
+  { std::ofstream(root_ / "ok.yaml") << "odometry:\n  preprocess:\n    max_range_m: 20\n"; }
+  auto farthest_m = [](const fs::path& cloud) {
+    float r = 0;
+    for (const auto& p : read_pcd(cloud).scan.points) r = std::max(r, std::hypot(p.x, p.y));
+    return r;
+  };
   r = run_cli("run " + (root_ / "pcd").string() + " -o " + (root_ / "okc").string() +
-              " --mode odometry --quiet -n 2 --sensor vlp16 --config " + (root_ / "ok.yaml").string());
-  EXPECT_EQ(r.exit_code, 0) << r.output;
+              " --mode odometry --quiet -n 2 --save-keyframes --sensor vlp16 --config " + (root_ / "ok.yaml").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_LE(farthest_m(root_ / "okc" / "keyframes" / "000000.pcd"), 20.5f);
+  r = run_cli("run " + (root_ / "pcd").string() + " -o " + (root_ / "okp").string() +
+              " --mode odometry --quiet -n 2 --save-keyframes --sensor vlp16");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_GT(farthest_m(root_ / "okp" / "keyframes" / "000000.pcd"), 40.f);
 }
