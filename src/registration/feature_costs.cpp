@@ -28,10 +28,20 @@ double plane_residual(const PlaneMatch& m, const Eigen::Matrix3d& R, const Eigen
   return m.normal.dot(Rp + t) + m.offset;
 }
 
+Eigen::Matrix<double, 2, 3> perpendicular_basis(const Eigen::Vector3d& dir) {
+  const Eigen::Vector3d helper =
+      std::abs(dir.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
+  const Eigen::Vector3d e1 = helper.cross(dir).normalized();
+  Eigen::Matrix<double, 2, 3> E;
+  E.row(0) = e1.transpose();
+  E.row(1) = dir.cross(e1).transpose();
+  return E;
+}
+
 FeatureCost::FeatureCost(const std::vector<EdgeMatch>& edges,
                          const std::vector<PlaneMatch>& planes, double huber_delta_m)
     : edges_(edges), planes_(planes), delta_(huber_delta_m) {
-  set_num_residuals(static_cast<int>(3 * edges.size() + planes.size()));
+  set_num_residuals(static_cast<int>(2 * edges.size() + planes.size()));
   mutable_parameter_block_sizes()->push_back(7);
 }
 
@@ -43,10 +53,17 @@ bool FeatureCost::Evaluate(double const* const* parameters, double* residuals,
   double* J = (jacobians && jacobians[0]) ? jacobians[0] : nullptr;  // row-major rows x 7
   std::size_t row = 0;
   for (const auto& m : edges_) {
-    Jacobian36 Je;
-    Eigen::Vector3d r = edge_residual(m, R, t, J ? &Je : nullptr);
-    robustify_huber<3>(delta_, r, J ? &Je : nullptr);
-    for (int i = 0; i < 3; ++i, ++row) {
+    // The residual lies in the plane perpendicular to the line: its coordinates in an
+    // orthonormal basis of that plane have the same norm and give the same J^T J in two rows
+    // instead of three (Ceres' work per iteration grows with the rows).
+    Jacobian36 J3;
+    const Eigen::Vector3d r3 = edge_residual(m, R, t, J ? &J3 : nullptr);
+    const Eigen::Matrix<double, 2, 3> E = perpendicular_basis(m.line_dir);
+    Eigen::Vector2d r = E * r3;
+    Eigen::Matrix<double, 2, 6> Je;
+    if (J) Je.noalias() = E * J3;
+    robustify_huber<2>(delta_, r, J ? &Je : nullptr);
+    for (int i = 0; i < 2; ++i, ++row) {
       residuals[row] = r[i];
       if (J) {
         Eigen::Map<Eigen::Matrix<double, 1, 7>> Jrow(J + 7 * row);

@@ -1,6 +1,7 @@
 // Analytic Jacobians of the residuals against numerical differentiation through the manifold.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 
 #include "scfloam/registration/feature_costs.hpp"
@@ -89,19 +90,30 @@ TEST(FeatureCosts, CeresCostEvaluatesEveryMatchWithTangentJacobian) {
   std::vector<EdgeMatch> edges{{{1, 2, 3}, {100, -30, 5}, Eigen::Vector3d::UnitX()}};
   std::vector<PlaneMatch> planes{{{-1, 0, 2}, Eigen::Vector3d::UnitZ(), -3.0}};
   FeatureCost cost(edges, planes, 0.1);
-  ASSERT_EQ(cost.num_residuals(), 4);
+  ASSERT_EQ(cost.num_residuals(), 3);  // two rows per edge, one per plane
   double x[7];
   pose_to_block(T, x);
   const double* params[] = {x};
-  double residuals[4], jac[4 * 7];
+  double residuals[3], jac[3 * 7];
   double* jacs[] = {jac};
   ASSERT_TRUE(cost.Evaluate(params, residuals, jacs));
+  // Edge: the two rows carry the robustified point-to-line vector's norm and its J^T J.
+  Jacobian36 Je;
+  Eigen::Vector3d re = edge_residual(edges[0], T.linear(), T.translation(), &Je);
+  robustify_huber<3>(0.1, re, &Je);
+  EXPECT_NEAR(std::hypot(residuals[0], residuals[1]), re.norm(), 1e-12);
+  Eigen::Matrix<double, 2, 6> J2;
+  for (int i = 0; i < 2; ++i)
+    for (int k = 0; k < 6; ++k) J2(i, k) = jac[i * 7 + k];
+  EXPECT_LT((J2.transpose() * J2 - Je.transpose() * Je).norm(), 1e-9 * (Je.transpose() * Je).norm());
+  EXPECT_NEAR(Eigen::Vector2d(residuals[0], residuals[1]).dot(J2.col(3)),
+              re.dot(Je.col(3)), 1e-9);  // same gradient
   Jacobian16 Jp;
   Eigen::Matrix<double, 1, 1> rp(plane_residual(planes[0], T.linear(), T.translation(), &Jp));
   robustify_huber<1>(0.1, rp, &Jp);
-  EXPECT_NEAR(residuals[3], rp[0], 1e-12);
-  for (int k = 0; k < 6; ++k) EXPECT_NEAR(jac[3 * 7 + k], Jp[k], 1e-12);
-  EXPECT_EQ(jac[3 * 7 + 6], 0.0);
+  EXPECT_NEAR(residuals[2], rp[0], 1e-12);
+  for (int k = 0; k < 6; ++k) EXPECT_NEAR(jac[2 * 7 + k], Jp[k], 1e-12);
+  EXPECT_EQ(jac[2 * 7 + 6], 0.0);
 }
 
 TEST(PoseManifold, PlusMinusRoundTripAndStaysOnSO3) {

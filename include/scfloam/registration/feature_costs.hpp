@@ -35,6 +35,9 @@ Eigen::Vector3d edge_residual(const EdgeMatch& m, const Eigen::Matrix3d& R,
 double plane_residual(const PlaneMatch& m, const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
                       Jacobian16* J);
 
+// Orthonormal rows spanning the plane perpendicular to the unit vector `dir`.
+Eigen::Matrix<double, 2, 3> perpendicular_basis(const Eigen::Vector3d& dir);
+
 // Huber loss folded into the residual: r <- sqrt(rho(|r|^2)) r / |r|, so that the squared
 // norm equals Huber's rho(s) = s for s <= delta^2, 2 delta sqrt(s) - delta^2 above; J is
 // transformed with the exact derivative. Keeps the loss per match inside one residual block.
@@ -53,7 +56,9 @@ void robustify_huber(double delta, Eigen::Matrix<double, Rows, 1>& r,
   r *= g;
 }
 
-// All matches of one correspondence round as one residual block on the 7-double pose block.
+// All matches of one correspondence round as one residual block on the 7-double pose block:
+// two rows per edge (the point-to-line vector in a basis perpendicular to the line), one per
+// plane, each robustified.
 class FeatureCost : public ceres::CostFunction {
  public:
   FeatureCost(const std::vector<EdgeMatch>& edges, const std::vector<PlaneMatch>& planes,
