@@ -1,0 +1,19 @@
+#!/usr/bin/env bash
+# ThreadSanitizer on the concurrent parts: the pipeline's stages and queues (test_pipeline,
+# including its threaded and interrupted runs), the bounded queue (test_core) and the ring-key
+# index's background rebuild (test_loop). Builds build-tsan (-DSCFLOAM_TSAN=ON); any race
+# report fails the run. Results: docs/robustness.md.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+shared="${SCFLOAM_SHARED_DIR:-$(cd .. && pwd)/shared}"
+build="${SCFLOAM_TSAN_BUILD:-build-tsan}"
+cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSCFLOAM_TSAN=ON \
+  -DSCFLOAM_BUILD_BENCH=OFF -DSCFLOAM_SHARED_DIR="$shared" >"$build.configure.log" 2>&1 ||
+  { cat "$build.configure.log"; exit 1; }
+cmake --build "$build" -j"$(nproc)" --target test_core test_loop test_pipeline
+# halt_on_error: the first race fails the test; second_deadlock_stack: both lock orders shown.
+export TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 history_size=4 ${TSAN_OPTIONS:-}"
+"$build/bin/test_core" --gtest_filter='BoundedQueue.*'
+"$build/bin/test_loop" --gtest_filter='RingKeyIndex.*'
+"$build/bin/test_pipeline"
+echo "tsan: no data races reported"
