@@ -75,8 +75,14 @@ TEST_F(RunOutputs, PcdFolderGivesTheSameTrajectoryAsTheKittiDirectory) {
     EXPECT_DOUBLE_EQ(ta.stamps_s[i], tb.stamps_s[i]);
     max_diff_m = std::max(max_diff_m, (ta.poses[i].translation() - tb.poses[i].translation()).norm());
   }
-  // The same float32 points in the same order: the same trajectory (to the file's digits).
+  // The same float32 points in the same order: the same trajectory, byte for byte.
   EXPECT_LT(max_diff_m, 1e-6);
+  auto bytes = [](const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  };
+  EXPECT_EQ(bytes(root_ / "out_kitti" / "poses_tum.txt"), bytes(root_ / "out_pcd" / "poses_tum.txt"));
+  EXPECT_EQ(bytes(root_ / "out_kitti" / "map.pcd"), bytes(root_ / "out_pcd" / "map.pcd"));
   EXPECT_GT(ta.poses.back().translation().norm(), 5.0);  // it moved
 }
 

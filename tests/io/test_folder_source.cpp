@@ -115,3 +115,23 @@ TEST(FolderSource, BinFolderReadsLikeKitti) {
   EXPECT_EQ(a.points[1000].x, b.points[1000].x);
   EXPECT_EQ(a.points[1000].intensity, b.points[1000].intensity);
 }
+
+TEST(FolderSource, SingleBinFileRoundTrip) {
+  const fs::path dir = test::scratch_dir("folder_bin");
+  std::vector<LidarPoint> pts(100);
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    pts[i].x = 0.5f * i;
+    pts[i].y = -0.25f * i;
+    pts[i].z = 1.f;
+    pts[i].intensity = 0.01f * i;
+  }
+  write_kitti_bin(dir / "000000.bin", pts);
+  const auto source = open_scan_source(dir / "000000.bin");
+  const Scan s = source->load(0);
+  ASSERT_EQ(s.points.size(), pts.size());
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    EXPECT_EQ(s.points[i].x, pts[i].x);
+    EXPECT_EQ(s.points[i].intensity, pts[i].intensity);
+  }
+  EXPECT_NE(source->describe().find("KITTI .bin file"), std::string::npos) << source->describe();
+}
