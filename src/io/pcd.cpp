@@ -80,6 +80,7 @@ PcdHeader parse_header(const std::filesystem::path& path, const std::string& byt
     if (!type) throw file_error(path, "PCD field `" + names[i] + "`: TYPE " + types[i] + " SIZE " + sizes[i] + " is not a number type");
     CloudField f{names[i], h.point_step, *type, counts.empty() ? 1 : parse_count(path, "COUNT", counts[i])};
     if (f.count == 0) throw file_error(path, "PCD field `" + names[i] + "` has COUNT 0");
+    if (f.count > 1024) throw file_error(path, "PCD field `" + names[i] + "`: COUNT " + counts[i] + " is implausible");
     h.point_step += size * f.count;
     h.fields.push_back(f);
   }
@@ -149,13 +150,23 @@ PointCloudFile read_pcd(const std::filesystem::path& path) {
     throw file_error(path, e.what());
   }
   if (h.data == "binary") {
-    const std::size_t need = h.points * h.point_step;
-    if (bytes.size() - h.data_begin < need)
+    const std::size_t have = bytes.size() - h.data_begin;
+    const std::size_t need = h.points <= have / h.point_step ? h.points * h.point_step : have + 1;
+    if (have < need)
       throw file_error(path, "PCD binary data is truncated (" + std::to_string(bytes.size() - h.data_begin) +
                                  " of " + std::to_string(need) + " bytes)");
     append_points(reinterpret_cast<const unsigned char*>(bytes.data()) + h.data_begin, h.points,
                   h.point_step, h.fields, layout, false, file.scan);
     return file;
+  }
+  // Bounds before any size product: a corrupt WIDTH must not overflow or allocate wildly.
+  if (h.data == "ascii") {
+    std::size_t values = 0;
+    for (const auto& f : h.fields) values += f.count;
+    if (h.points > (bytes.size() - h.data_begin + 1) / (2 * values))
+      throw file_error(path, "PCD ascii data is truncated (too short for " + std::to_string(h.points) + " points)");
+  } else if (h.points > 0xffffffffu / h.point_step) {
+    throw file_error(path, "PCD binary_compressed: " + std::to_string(h.points) + " points exceed the format's 4 GiB");
   }
   const auto rows = h.data == "ascii" ? pack_ascii(path, h, bytes) : unpack_compressed(path, h, bytes);
   append_points(rows.data(), h.points, h.point_step, h.fields, layout, false, file.scan);

@@ -81,6 +81,7 @@ PlyHeader parse_header(const std::filesystem::path& path, const std::string& byt
 // Skips one element's rows of binary data (list properties have a count prefix each).
 std::size_t skip_binary_element(const std::filesystem::path& path, const PlyElement& e, const std::string& bytes,
                                 std::size_t pos, bool big_endian) {
+  if (e.properties.empty()) return pos;  // rows of no bytes (a huge count must not loop)
   for (std::size_t i = 0; i < e.count; ++i) {
     for (const auto& p : e.properties) {
       std::size_t items = 1;
@@ -135,6 +136,8 @@ PointCloudFile read_ply(const std::filesystem::path& path) {
         if (!p) throw file_error(path, "PLY ascii data is truncated in element `" + e->name + "`");
         ++p;
       }
+    if (vertex->count > (bytes.size() - static_cast<std::size_t>(p - bytes.c_str()) + 1) / (2 * file.fields.size()))
+      throw file_error(path, "PLY ascii data is truncated (too short for " + std::to_string(vertex->count) + " vertices)");
     std::vector<unsigned char> rows(vertex->count * step);
     for (std::size_t i = 0; i < vertex->count; ++i)
       for (const auto& f : file.fields) {
@@ -151,7 +154,7 @@ PointCloudFile read_ply(const std::filesystem::path& path) {
   }
   std::size_t pos = h.data_begin;
   for (auto e = h.elements.begin(); e != vertex; ++e) pos = skip_binary_element(path, *e, bytes, pos, big_endian);
-  if (bytes.size() - pos < vertex->count * step)
+  if (vertex->count > (bytes.size() - pos) / step)
     throw file_error(path, "PLY binary data is truncated (" + std::to_string(bytes.size() - pos) + " of " +
                                std::to_string(vertex->count * step) + " vertex bytes)");
   append_points(reinterpret_cast<const unsigned char*>(bytes.data()) + pos, vertex->count, step, file.fields,

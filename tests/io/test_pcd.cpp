@@ -209,6 +209,13 @@ TEST(Pcd, TruncatedAndCorruptFilesGiveAnErrorNamingTheFile) {
   const fs::path no_xyz = dir / "noxyz.pcd";
   write_bytes(no_xyz, "VERSION 0.7\nFIELDS a b c\nSIZE 4 4 4\nTYPE F F F\nWIDTH 1\nHEIGHT 1\nPOINTS 1\nDATA ascii\n1 2 3\n");
   EXPECT_NE(error_of(no_xyz).find("no x, y and z"), std::string::npos) << error_of(no_xyz);
+  // A corrupt WIDTH whose size products would overflow: an error, no allocation or crash.
+  for (const char* data : {"ascii", "binary", "binary_compressed"}) {
+    const fs::path huge = dir / (std::string("huge_") + data + ".pcd");
+    write_bytes(huge, std::string("VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 4611686018427387904\n"
+                                  "HEIGHT 1\nDATA ") + data + "\n0123456789abcdef0123456789");
+    EXPECT_NE(error_of(huge).find(huge.string()), std::string::npos) << data << ": " << error_of(huge);
+  }
   const fs::path text = dir / "text.pcd";
   write_bytes(text, "hello world\n");
   EXPECT_NE(error_of(text).find("not a PCD file"), std::string::npos) << error_of(text);

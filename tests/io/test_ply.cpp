@@ -142,6 +142,13 @@ TEST(Ply, TruncatedAndBrokenFilesGiveAnErrorNamingTheFile) {
     write_bytes(header_only, bytes.substr(0, 40));
     EXPECT_NE(error_of(header_only).find("end_header"), std::string::npos) << error_of(header_only);
   }
+  for (const char* format : {"ascii", "binary_little_endian"}) {
+    const fs::path huge = dir / (std::string("huge_") + format + ".ply");
+    write_bytes(huge, std::string("ply\nformat ") + format + " 1.0\nelement junk 4611686018427387904\n"
+                      "element vertex 4611686018427387904\nproperty float x\nproperty float y\n"
+                      "property float z\nend_header\n0123456789abcdef");
+    EXPECT_NE(error_of(huge).find(huge.string()), std::string::npos) << format << ": " << error_of(huge);
+  }
   const fs::path mesh = dir / "mesh.ply";
   write_bytes(mesh, "ply\nformat ascii 1.0\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n3 0 1 2\n");
   EXPECT_NE(error_of(mesh).find("no vertex element"), std::string::npos) << error_of(mesh);
