@@ -15,7 +15,7 @@ namespace {
 
 constexpr std::uint8_t kMagic[8] = {0x89, 'M', 'C', 'A', 'P', '0', '\r', '\n'};
 constexpr std::uint64_t kRecordHeader = 9;          // opcode + uint64 length
-constexpr std::uint64_t kMaxChunkBytes = 1ull << 32;  // refuse absurd sizes from corrupt files
+constexpr std::uint64_t kMaxChunkBytes = 1ull << 30;  // refuse absurd sizes from corrupt files
 
 // Little-endian fields of one record body, bounds-checked.
 class Cursor {
@@ -57,6 +57,13 @@ std::vector<std::uint8_t> decompress(const std::string& compression, const std::
                                      const std::filesystem::path& path) {
   if (uncompressed_size > kMaxChunkBytes)
     throw file_error(path, "MCAP chunk claims " + std::to_string(uncompressed_size) + " bytes");
+  if (compression == "zstd") {
+    // A corrupt size field must not make us allocate before zstd has looked at the frame.
+    const unsigned long long framed = ZSTD_getFrameContentSize(src, size);
+    if (framed == ZSTD_CONTENTSIZE_ERROR ||
+        (framed != ZSTD_CONTENTSIZE_UNKNOWN && framed != uncompressed_size))
+      throw file_error(path, "bad zstd chunk (frame header disagrees with the chunk record)");
+  }
   // Refuse a size the compressed bytes cannot produce before allocating it (found by
   // fuzz/mcap_fuzz: a stored chunk claiming 2 GB): stored chunks are exactly their size, and
   // LZ4 expands at most 255:1.

@@ -31,7 +31,10 @@ class Ros1BagFile final : public BagFile {
       }
       for (const rosbag::MessageInstance& m : all) ++by_name[m.getTopic()].messages;
       for (auto& [name, info] : by_name) topics_.push_back(info);
-    } catch (const rosbag::BagException& e) {
+    } catch (const Error&) {
+      throw;
+    } catch (const std::exception& e) {
+      // rosbag::BagException, ros::Exception from corrupt headers, bad_alloc from corrupt sizes.
       throw file_error(path, std::string("cannot read ROS 1 bag: ") + e.what());
     }
   }
@@ -46,7 +49,7 @@ class Ros1BagFile final : public BagFile {
     try {
       rosbag::View view(bag_, rosbag::TopicQuery(topic));
       for (const rosbag::MessageInstance& m : view) index_.push_back(m);
-    } catch (const rosbag::BagException& e) {
+    } catch (const std::exception& e) {
       throw file_error(path_, "cannot index topic " + topic + ": " + e.what());
     }
   }
@@ -61,9 +64,7 @@ class Ros1BagFile final : public BagFile {
       bytes.resize(m.size());
       ros::serialization::OStream stream(bytes.data(), static_cast<std::uint32_t>(bytes.size()));
       m.write(stream);
-    } catch (const rosbag::BagException& e) {
-      throw file_error(path_, "message " + std::to_string(index) + ": " + e.what());
-    } catch (const ros::Exception& e) {
+    } catch (const std::exception& e) {
       throw file_error(path_, "message " + std::to_string(index) + ": " + e.what());
     }
   }

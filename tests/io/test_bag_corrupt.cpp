@@ -6,6 +6,7 @@
 
 #include "scfloam/error.hpp"
 #include "scfloam/io/bag_source.hpp"
+#include "test_bag_writers.hpp"
 #include "test_paths.hpp"
 
 namespace scfloam {
@@ -67,6 +68,36 @@ TEST(BagCorrupt, Mcap) {
 TEST(BagCorrupt, Sqlite) {
   SCFLOAM_SHARED_DATA_OR_SKIP(p, "bags/rosbags-rs/tests/test_bags/test_bag_sqlite3/test_bag_sqlite3.db3");
   damage(p, "sqlite");
+}
+
+// Bags written here, whose messages sit in compressed chunks: damage reaches lz4 / zstd data.
+std::vector<test::OwnedCloud> small_clouds() {
+  std::vector<test::OwnedCloud> clouds;
+  for (int k = 0; k < 6; ++k) {
+    std::vector<LidarPoint> pts(200);
+    for (std::size_t i = 0; i < pts.size(); ++i) pts[i].x = static_cast<float>(i + k);
+    clouds.push_back(test::make_cloud(pts, 100.0 + k, {}));
+  }
+  return clouds;
+}
+
+TEST(BagCorrupt, Ros1Lz4Chunks) {
+  const auto dir = test::scratch_dir("bag_corrupt_src_ros1");
+  test::write_ros1_bag(dir / "lz4.bag", {"/points"}, small_clouds());
+  damage(dir / "lz4.bag", "ros1_lz4");
+}
+
+TEST(BagCorrupt, McapZstdAndLz4Chunks) {
+  const auto dir = test::scratch_dir("bag_corrupt_src_mcap");
+  for (const char* compression : {"zstd", "lz4"}) {
+    test::McapTestWriter w(compression, true, true, 2);
+    const auto ch = w.add_topic("/points", "sensor_msgs/msg/PointCloud2");
+    for (const auto& c : small_clouds())
+      w.write(ch, static_cast<std::uint64_t>(c.meta.stamp_sec) * 1000000000ULL, test::encode_cdr(c, false));
+    const auto path = dir / (std::string(compression) + ".mcap");
+    test::write_bytes(path, w.finish());
+    damage(path, std::string("mcap_") + compression);
+  }
 }
 
 TEST(BagCorrupt, NotABag) {

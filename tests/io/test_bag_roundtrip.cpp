@@ -1,8 +1,6 @@
 // Bags written here (ROS 1 through librosbag's writer, ROS 2 MCAP and sqlite3 through the test
 // writers) carrying simulated-like scans, read back through open_bag_source / inspect_bag.
 #include <gtest/gtest.h>
-#include <rosbag/bag.h>
-#include <sensor_msgs/PointCloud2.h>
 
 #include <thread>
 
@@ -49,31 +47,10 @@ void expect_scan(const Scan& s, const std::vector<LidarPoint>& pts, double stamp
 constexpr int kFrames = 5;
 double stamp_of(int i) { return 1700000000.0 + 0.1 * i + 0.000123; }
 
-// ROS 1 bag through librosbag's writer (LZ4 chunks), messages built by ROS's sensor_msgs.
 void write_ros1_bag(const std::filesystem::path& path, const std::vector<std::string>& topics) {
-  rosbag::Bag bag(path.string(), rosbag::bagmode::Write);
-  bag.setCompression(rosbag::compression::LZ4);
-  for (int i = 0; i < kFrames; ++i) {
-    const test::OwnedCloud c = test::make_cloud(ring_scan(i), stamp_of(i), {});
-    sensor_msgs::PointCloud2 msg;
-    msg.header.stamp = ros::Time(static_cast<std::uint32_t>(c.meta.stamp_sec), c.meta.stamp_nanosec);
-    msg.header.frame_id = c.meta.frame_id;
-    msg.height = c.meta.height;
-    msg.width = c.meta.width;
-    for (const PointField& f : c.meta.fields) {
-      sensor_msgs::PointField pf;
-      pf.name = f.name;
-      pf.offset = f.offset;
-      pf.datatype = f.datatype;
-      pf.count = f.count;
-      msg.fields.push_back(pf);
-    }
-    msg.point_step = c.meta.point_step;
-    msg.row_step = c.meta.row_step;
-    msg.data = c.data;
-    msg.is_dense = true;
-    for (const auto& topic : topics) bag.write(topic, msg.header.stamp, msg);
-  }
+  std::vector<test::OwnedCloud> clouds;
+  for (int i = 0; i < kFrames; ++i) clouds.push_back(test::make_cloud(ring_scan(i), stamp_of(i), {}));
+  test::write_ros1_bag(path, topics, clouds);
 }
 
 TEST(BagRoundTrip, Ros1ThroughLibrosbagWriter) {

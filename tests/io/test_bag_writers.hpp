@@ -4,6 +4,8 @@
 #pragma once
 
 #include <lz4frame.h>
+#include <rosbag/bag.h>
+#include <sensor_msgs/PointCloud2.h>
 #include <sqlite3.h>
 #include <zstd.h>
 
@@ -370,6 +372,35 @@ inline void write_sqlite_bag(const std::filesystem::path& db_path, const std::st
   }
   sqlite3_finalize(st);
   sqlite3_close(db);
+}
+
+// ROS 1 bag through librosbag's writer (LZ4 chunks), messages built by ROS's sensor_msgs
+// classes; every cloud goes to every topic.
+inline void write_ros1_bag(const std::filesystem::path& path, const std::vector<std::string>& topics,
+                           const std::vector<OwnedCloud>& clouds) {
+  rosbag::Bag bag(path.string(), rosbag::bagmode::Write);
+  bag.setCompression(rosbag::compression::LZ4);
+  for (const OwnedCloud& c : clouds) {
+    sensor_msgs::PointCloud2 msg;
+    msg.header.stamp = ros::Time(static_cast<std::uint32_t>(c.meta.stamp_sec), c.meta.stamp_nanosec);
+    msg.header.frame_id = c.meta.frame_id;
+    msg.height = c.meta.height;
+    msg.width = c.meta.width;
+    for (const PointField& f : c.meta.fields) {
+      sensor_msgs::PointField pf;
+      pf.name = f.name;
+      pf.offset = f.offset;
+      pf.datatype = f.datatype;
+      pf.count = f.count;
+      msg.fields.push_back(pf);
+    }
+    msg.is_bigendian = c.meta.is_bigendian;
+    msg.point_step = c.meta.point_step;
+    msg.row_step = c.meta.row_step;
+    msg.data = c.data;
+    msg.is_dense = c.meta.is_dense;
+    for (const auto& topic : topics) bag.write(topic, msg.header.stamp, msg);
+  }
 }
 
 }  // namespace scfloam::test
