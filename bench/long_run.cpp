@@ -1,0 +1,159 @@
+// Long run (issue 8): replays one simulated patrol lap (scfloam simulate --scenario patrol)
+// lap after lap with continuing stamps, through the whole pipeline, for N frames: a robot
+// patrolling for an hour. Samples the resident memory while it runs and writes
+//   OUT/memory.csv   elapsed_s, frames_read, rss_mb           (every --sample-s seconds)
+//   OUT/frames.csv   frame, features_ms, registration_ms       (every frame)
+//   OUT/summary.json the run's summary.json plus what is stored per keyframe
+// Usage: long_run LAP_DIR OUT_DIR [--frames 20000] [--mode optimized] [--sample-s 2]
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <mutex>
+#include <sstream>
+#include <string>
+#include <thread>
+
+#include "scfloam/atomic_file.hpp"
+#include "scfloam/backend/pose_graph.hpp"
+#include "scfloam/error.hpp"
+#include "scfloam/io/scan_source.hpp"
+#include "scfloam/pipeline/outputs.hpp"
+#include "scfloam/pipeline/pipeline.hpp"
+#include "scfloam/stats.hpp"
+
+using namespace scfloam;
+namespace fs = std::filesystem;
+
+namespace {
+
+// Frame i is lap frame i mod N, stamped as if the laps followed each other; the lap's poses
+// are periodic (frame N has frame 0's pose), so the ground truth repeats too.
+class RepeatingSource : public ScanSource {
+ public:
+  RepeatingSource(std::unique_ptr<ScanSource> lap, std::size_t frames)
+      : lap_(std::move(lap)), frames_(frames), lap_gt_(lap_->ground_truth_lidar()) {}
+  std::size_t size() const override { return frames_; }
+  Scan load(std::size_t index) const override {
+    Scan scan = lap_->load(index % lap_->size());
+    scan.timestamp_s = 0.1 * static_cast<double>(index);
+    std::size_t seen = read_.load();
+    while (index + 1 > seen && !read_.compare_exchange_weak(seen, index + 1)) {
+    }
+    return scan;
+  }
+  std::string describe() const override {
+    return lap_->describe() + " repeated to " + std::to_string(frames_) + " frames";
+  }
+  std::optional<Eigen::Isometry3d> T_cam0_lidar() const override { return lap_->T_cam0_lidar(); }
+  PoseList ground_truth_lidar() const override {
+    if (lap_gt_.size() != lap_->size()) return {};
+    PoseList gt(frames_);
+    for (std::size_t i = 0; i < frames_; ++i) gt[i] = lap_gt_[i % lap_gt_.size()];
+    return gt;
+  }
+  std::size_t frames_read() const { return read_.load(); }
+
+ private:
+  std::unique_ptr<ScanSource> lap_;
+  std::size_t frames_;
+  PoseList lap_gt_;
+  mutable std::atomic<std::size_t> read_{0};
+};
+
+double current_rss_mb() {
+  std::ifstream in("/proc/self/status");
+  std::string line;
+  while (std::getline(in, line))
+    if (line.rfind("VmRSS:", 0) == 0) return std::stod(line.substr(6)) / 1024.0;
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) try {
+  if (argc < 3) {
+    std::fprintf(stderr, "usage: long_run LAP_DIR OUT_DIR [--frames 20000] [--mode optimized] [--sample-s 2]\n");
+    return 2;
+  }
+  const fs::path lap_dir = argv[1], out_dir = argv[2];
+  std::size_t frames = 20000;
+  std::string mode_text = "optimized";
+  double sample_s = 2;
+  for (int i = 3; i + 1 < argc; i += 2) {
+    const std::string key = argv[i], value = argv[i + 1];
+    if (key == "--frames") frames = std::stoul(value);
+    else if (key == "--mode") mode_text = value;
+    else if (key == "--sample-s") sample_s = std::stod(value);
+    else throw Error("unknown option " + key);
+  }
+  const auto mode = parse_mode(mode_text);
+  if (!mode) throw Error("unknown mode " + mode_text);
+  fs::create_directories(out_dir);
+  RepeatingSource source(open_scan_source(lap_dir), frames);
+
+  // Memory sampler: resident set size against frames read, while the pipeline runs.
+  std::ostringstream memory_csv;
+  memory_csv << "elapsed_s,frames_read,rss_mb\n";
+  std::mutex m;
+  std::condition_variable cv;
+  bool done = false;
+  const auto start = std::chrono::steady_clock::now();
+  std::thread sampler([&] {
+    std::unique_lock<std::mutex> lock(m);
+    do {
+      const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      char row[96];
+      std::snprintf(row, sizeof row, "%.1f,%zu,%.1f\n", t, source.frames_read(), current_rss_mb());
+      memory_csv << row;
+    } while (!cv.wait_for(lock, std::chrono::duration<double>(sample_s), [&] { return done; }));
+  });
+
+  RunOptions options;
+  options.mode = *mode;
+  options.progress = true;
+  RunResult result = run_slam(source, SlamConfig{}, options);
+  {
+    std::lock_guard<std::mutex> lock(m);
+    done = true;
+  }
+  cv.notify_one();
+  sampler.join();
+
+  write_file_atomic(out_dir / "memory.csv", memory_csv.str());
+  write_file_atomic(out_dir / "frames.csv", [&](std::ostream& out) {
+    out << "frame,features_ms,registration_ms\n";
+    const auto& f = result.timing_ms["features"];
+    const auto& r = result.timing_ms["registration"];
+    char row[64];
+    for (std::size_t i = 0; i < f.size() && i < r.size(); ++i) {
+      std::snprintf(row, sizeof row, "%zu,%.3f,%.3f\n", i, f[i], r[i]);
+      out << row;
+    }
+  });
+  // What every keyframe keeps for the rest of the run.
+  std::size_t edge_points = 0, plane_points = 0, raw_points = 0;
+  for (const auto& kf : result.keyframes) {
+    edge_points += kf->edges.size();
+    plane_points += kf->planes.size();
+    raw_points += kf->raw.size();
+  }
+  const double kfs = std::max<std::size_t>(1, result.keyframes.size());
+  nlohmann::json summary = make_summary(source, result);
+  summary["keyframe_storage"] = {
+      {"keyframes", result.keyframes.size()},
+      {"edge_points_per_keyframe", edge_points / kfs},
+      {"plane_points_per_keyframe", plane_points / kfs},
+      {"raw_points_per_keyframe", raw_points / kfs},
+      {"feature_bytes_per_keyframe", (edge_points + plane_points + raw_points) * sizeof(Eigen::Vector3f) / kfs},
+      {"graph_nodes", result.graph ? result.graph->size() : 0}};
+  write_file_atomic(out_dir / "summary.json", summary.dump(2) + "\n");
+  std::printf("%zu frames, %zu keyframes, peak RSS %.0f MB, %.1f s\n", result.T_world_lidar.size(),
+              result.keyframes.size(), peak_rss_mb(), result.wall_s);
+  return 0;
+} catch (const std::exception& e) {
+  std::fprintf(stderr, "error: %s\n", e.what());
+  return 1;
+}
