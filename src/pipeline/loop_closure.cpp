@@ -74,6 +74,11 @@ bool LoopClosure::add(const KeyframePtr& keyframe, const LoopQuery& query) {
   watch.restart();
   const PoseGraphReport report = graph_.optimize(config_.pose_graph);
   optimization_ms_.push_back(watch.elapsed_ms());
+  publish(report);
+  return true;
+}
+
+void LoopClosure::publish(const PoseGraphReport& report) {
   // Loops the graph found inconsistent are recorded as rejected in the log.
   for (std::size_t edge : report.rejected_edges) {
     std::size_t loop_number = 0;
@@ -84,7 +89,6 @@ bool LoopClosure::add(const KeyframePtr& keyframe, const LoopQuery& query) {
   }
   accepted_ = graph_.loop_edge_count();
   store_.set_optimized(graph_.poses());
-  return true;
 }
 
 }  // namespace scfloam

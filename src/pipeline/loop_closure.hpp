@@ -35,6 +35,8 @@ class LoopClosure {
  private:
   std::vector<KeyframeView> submap_around(std::size_t loop_kf, std::size_t limit,
                                           std::size_t& loop_index) const;
+  // Logs the loops a solve switched off and hands the poses to the store.
+  void publish(const PoseGraphReport& report);
   LoopMatch register_features(const KeyframeView& current, std::size_t loop_kf, std::size_t limit,
                               double sc_yaw_rad);
 

@@ -177,7 +177,11 @@ class OdometryStage {
 
   // Processes one scan; returns the new keyframe, if this scan made one.
   KeyframePtr process(std::size_t frame, const Scan& scan, RunResult& result) {
-    if (loops_ && store_.version() != seen_version_) reanchor();
+    if (loops_ && store_.version() != seen_version_) {
+      Stopwatch watch;
+      reanchor();
+      result.timing_ms["map_rebuild"].push_back(watch.elapsed_ms());
+    }
     const OdometryResult odom = odometry_.process(scan);
     // The odometry's own chain of relative motions: its trajectory before any correction.
     const Eigen::Isometry3d T_last_current = has_last_ ? T_world_last_.inverse() * odom.T_world_lidar
@@ -226,11 +230,11 @@ class OdometryStage {
     seen_version_ = store_.version();
     const PoseList corrected = store_.current_poses();
     if (corrected.size() != kf_poses_.size() || kf_poses_.empty()) return;  // cannot happen
+    if (!map_needs_rebuild(corrected)) return;  // the odometry stays in its frame, unharmed
     const Eigen::Isometry3d correction = corrected.back() * kf_poses_.back().inverse();
     const Eigen::Isometry3d T_world_now = orthonormalized(correction * T_world_last_);
     kf_poses_ = corrected;
     T_world_last_ = T_world_now;
-    if (!config_.pipeline.rebuild_map_after_loop) return;
     std::vector<std::pair<Eigen::Isometry3d, const FeatureCloud*>> edges, planes;
     std::vector<KeyframePtr> keep;
     const double radius = config_.odometry.map.radius_m;
@@ -241,6 +245,29 @@ class OdometryStage {
       planes.emplace_back(corrected[i], &keep.back()->planes);
     }
     odometry_.reset_map(edges, planes, T_world_now);
+    last_rebuild_position_ = T_world_now.translation();
+  }
+
+  // Rebuilding costs hundreds of milliseconds (every keyframe within the map radius). The
+  // loops after the first of an episode move the keyframes around here by millimetres:
+  // then the map is as good as rebuilt, and the pose graph alone carries the correction.
+  bool map_needs_rebuild(const PoseList& corrected) const {
+    if (!config_.pipeline.rebuild_map_after_loop) return false;
+    const double min_shift_m = config_.pipeline.map_rebuild_min_shift_m;
+    const double radius_m = config_.odometry.map.radius_m;
+    const Eigen::Vector3d here = kf_poses_.back().translation();
+    if (min_shift_m <= 0 || (here - last_rebuild_position_).norm() > 0.2 * radius_m) return true;
+    constexpr double kLeverArm_m = 30.0;  // typical range of a map point from its keyframe
+    const Eigen::Isometry3d old_inv = kf_poses_.back().inverse();
+    const Eigen::Isometry3d new_inv = corrected.back().inverse();
+    for (std::size_t i = 0; i < kf_poses_.size(); ++i) {
+      if ((kf_poses_[i].translation() - here).norm() > radius_m) continue;
+      const Eigen::Isometry3d change = (old_inv * kf_poses_[i]).inverse() * (new_inv * corrected[i]);
+      const double shift_m =
+          change.translation().norm() + kLeverArm_m * rotation_angle_rad(change.linear());
+      if (shift_m > min_shift_m) return true;
+    }
+    return false;
   }
 
   const SlamConfig& config_;
@@ -253,6 +280,8 @@ class OdometryStage {
   PoseList kf_poses_;  // keyframe poses in the odometry's current frame
   std::vector<std::pair<std::size_t, Eigen::Isometry3d>> anchors_;  // per frame: kf, T_kf_frame
   Eigen::Isometry3d T_world_last_ = Eigen::Isometry3d::Identity();
+  // Far from anything at the start, so that the first correction rebuilds.
+  Eigen::Vector3d last_rebuild_position_ = Eigen::Vector3d::Constant(1e9);
   Eigen::Isometry3d T_chain_ = Eigen::Isometry3d::Identity();
   bool has_last_ = false;
 };
@@ -283,12 +312,19 @@ RunResult run_slam(const ScanSource& source, const SlamConfig& base_config,
 
   ScanPrefetcher prefetcher(source, count);
   ProgressBar progress(mode_name(options.mode), count, options.progress);
+  // Where the odometry thread waits: for the next scan, and for room in the loop queue.
+  std::vector<double>& wait_input_ms = result.timing_ms["wait_input"];
+  std::vector<double>& wait_queue_ms = result.timing_ms["wait_loop_queue"];
+  Stopwatch waiting;
   while (auto item = prefetcher.next()) {
+    wait_input_ms.push_back(waiting.elapsed_ms());
     const auto& [index, scan] = *item;
     KeyframePtr kf = odometry.process(index, scan, result);
     if (kf && loops) {
       if (threads) {
+        Stopwatch queue_watch;
         threads->push(std::move(kf));
+        wait_queue_ms.push_back(queue_watch.elapsed_ms());
       } else {
         closure.add(kf, detection.detect(kf));
       }
@@ -299,6 +335,7 @@ RunResult run_slam(const ScanSource& source, const SlamConfig& base_config,
     std::snprintf(note, sizeof note, "%.1f ms/frame, %zu loops", f.back() + r.back(),
                   closure.accepted_loops());
     progress.update(index + 1, note);
+    waiting.restart();
     if (options.stop && options.stop->load() && index + 1 < count) {
       result.interrupted = true;
       break;
@@ -306,6 +343,7 @@ RunResult run_slam(const ScanSource& source, const SlamConfig& base_config,
   }
   if (threads) threads->finish();
   progress.finish();
+  if (wait_queue_ms.empty()) result.timing_ms.erase("wait_loop_queue");
 
   result.keyframe_poses = store.current_poses();
   result.T_world_lidar = odometry.final_poses(result.keyframe_poses);
