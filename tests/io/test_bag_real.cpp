@@ -91,7 +91,7 @@ TEST(BagReal, WebvizFixtures) {
   EXPECT_EQ(counts(empty_def).at("/led_array_status"), 14u);
 }
 
-void check_rosbags_rs(const std::filesystem::path& path, const std::string& kind) {
+void check_rosbags_rs(const std::filesystem::path& path, const std::string& kind, double first_stamp_s) {
   const InputInfo info = inspect_bag(path, {});
   EXPECT_EQ(info.kind, kind);
   EXPECT_EQ(info.topics.size(), 94u);
@@ -104,8 +104,9 @@ void check_rosbags_rs(const std::filesystem::path& path, const std::string& kind
   EXPECT_EQ(info.point_fields, (std::vector<std::string>{"x:float32", "y:float32", "z:float32"}));
   const auto source = open_bag_source(path, {});
   const Scan s0 = source->load(0), s1 = source->load(1);
-  // Stamps of the two clouds (header.stamp in the CDR; 1749315324 s + 5.4 s and 14.8 s).
-  EXPECT_NEAR(s0.timestamp_s, 1749315324.0 + 0.75, 1.0);
+  // header.stamp of the first cloud (decoded by hand from the CDR bytes; the two files were
+  // written separately and carry different stamps).
+  EXPECT_NEAR(s0.timestamp_s, first_stamp_s, 1e-6);
   EXPECT_GT(s1.timestamp_s, s0.timestamp_s);
   for (const LidarPoint& p : s0.points) EXPECT_EQ(p.x * p.x + p.y * p.y + p.z * p.z, 0.f);
   EXPECT_EQ(info.start_time_s, s0.timestamp_s);
@@ -114,10 +115,13 @@ void check_rosbags_rs(const std::filesystem::path& path, const std::string& kind
 
 TEST(BagReal, RosbagsRsSqliteAndMcap) {
   SCFLOAM_SHARED_DATA_OR_SKIP(dir, "bags/rosbags-rs/tests/test_bags");
-  check_rosbags_rs(dir / "test_bag_sqlite3", "ROS 2 bag (sqlite3)");
-  check_rosbags_rs(dir / "test_bag_mcap", "ROS 2 bag (MCAP)");
-  check_rosbags_rs(dir / "test_bag_mcap" / "test_bag_mcap.mcap", "ROS 2 bag (MCAP)");
-  check_rosbags_rs(dir / "test_bag_sqlite3" / "test_bag_sqlite3.db3", "ROS 2 bag (sqlite3)");
+  // sqlite3: sec 0x68446EFC, nanosec 0x2CA5C100 in the first PointCloud2 row.
+  const double sqlite_stamp = 1749315324.749060352;
+  check_rosbags_rs(dir / "test_bag_sqlite3", "ROS 2 bag (sqlite3)", sqlite_stamp);
+  check_rosbags_rs(dir / "test_bag_sqlite3" / "test_bag_sqlite3.db3", "ROS 2 bag (sqlite3)", sqlite_stamp);
+  const double mcap_stamp = 1749315324.973697024;  // found by hand in the uncompressed chunk
+  check_rosbags_rs(dir / "test_bag_mcap", "ROS 2 bag (MCAP)", mcap_stamp);
+  check_rosbags_rs(dir / "test_bag_mcap" / "test_bag_mcap.mcap", "ROS 2 bag (MCAP)", mcap_stamp);
 }
 
 TEST(BagReal, Rosbag2Resources) {
