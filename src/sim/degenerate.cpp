@@ -153,8 +153,9 @@ Scenario stationary(std::uint64_t seed, std::size_t frames, double mount) {
     if (k * 0.01 >= kStopped && k * 0.01 <= go) s[k] = s[k - 1];
   sc.trajectory = drive_arclength(lane, false, s, 0.01, ground_of(sc.world), mount);
   sc.frames = frames;
-  sc.degenerate_first_frame = static_cast<std::size_t>(std::ceil(kStopped / kFramePeriod));
-  sc.degenerate_end_frame = static_cast<std::size_t>(std::floor(go / kFramePeriod)) + 1;
+  // Frames strictly inside the standstill (the boundary frames still see the braking's pitch).
+  sc.degenerate_first_frame = static_cast<std::size_t>(std::ceil(kStopped / kFramePeriod)) + 1;
+  sc.degenerate_end_frame = static_cast<std::size_t>(std::floor(go / kFramePeriod));
   set_route_length(sc);
   sc.description = "stationary: the avenue; stops at 3-8 s, stands " + std::to_string(static_cast<int>(stand_s)) +
                    " s with traffic around, drives on";
