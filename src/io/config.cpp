@@ -32,6 +32,7 @@ std::vector<Binding> bindings(SlamConfig& c) {
       {pre, "min_range_m", &o.preprocess.min_range_m},
       {pre, "max_range_m", &o.preprocess.max_range_m},
       {pre, "deskew", &o.preprocess.deskew},
+      {pre, "elevation_correction_deg", &o.preprocess.elevation_correction_deg},
       {ring, "lidar", &o.rings.lidar},
       {ring, "use_ring_field", &o.rings.use_ring_field},
       {ring, "min_points_per_ring", &o.rings.min_points_per_ring},

@@ -1,5 +1,8 @@
 #include "scfloam/odometry/odometry.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 #include "scfloam/error.hpp"
 #include "scfloam/features/deskew.hpp"
 #include "scfloam/features/feature_extractor.hpp"
@@ -35,6 +38,46 @@ struct Odometry::Impl {
   Eigen::Vector3d last_cleanup_position = Eigen::Vector3d::Zero();
 };
 
+namespace {
+
+// How many of the last frame's intervals have passed: 1 when stamps are missing, repeat or run
+// backwards (nothing better to go on); capped at 30 (3 s at 10 Hz), beyond which constant
+// velocity is a guess either way.
+double interval_ratio(double last_interval_s, double interval_s) {
+  if (!(last_interval_s > 0) || !(interval_s > 0)) return 1.0;
+  return std::min(interval_s / last_interval_s, 30.0);
+}
+
+// The relative motion `T_delta` continued for `ratio` intervals at the same body-frame velocity.
+Eigen::Isometry3d scaled_motion(const Eigen::Isometry3d& T_delta, double ratio) {
+  // Regular frames keep exactly the last motion: recorded stamps jitter by a few ms (KITTI's
+  // times.txt does) while the spin period does not, so only a clear change (a dropped frame,
+  // a rate change) is worth following.
+  if (ratio > 1.0 / 1.5 && ratio < 1.5) return T_delta;
+  Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
+  out.linear() = so3_exp(ratio * so3_log(T_delta.linear()));
+  out.translation() = ratio * T_delta.translation();
+  return out;
+}
+
+// Rotates each point up by `angle_deg` in its own vertical plane (after ring assignment, which
+// reads the sensor's own elevations).
+void correct_elevation(FeatureCloud& points, double angle_deg) {
+  if (angle_deg == 0) return;
+  const float c = static_cast<float>(std::cos(angle_deg * M_PI / 180.0));
+  const float s = static_cast<float>(std::sin(angle_deg * M_PI / 180.0));
+  for (Eigen::Vector3f& p : points) {
+    const float horizontal = std::hypot(p.x(), p.y());
+    if (horizontal < 1e-3f) continue;
+    const float new_horizontal = horizontal * c - p.z() * s;
+    p.z() = p.z() * c + horizontal * s;
+    p.x() *= new_horizontal / horizontal;
+    p.y() *= new_horizontal / horizontal;
+  }
+}
+
+}  // namespace
+
 Odometry::Odometry(const OdometryConfig& config) : impl_(std::make_unique<Impl>(config)) {
   const auto& p = config.preprocess;
   if (!(p.min_range_m >= 0) || !(p.max_range_m > p.min_range_m))
@@ -60,6 +103,8 @@ OdometryResult Odometry::process(const Scan& scan) {
     points = &s.deskewed;
   }
   s.extractor.extract(*points, scan.has_ring && c.rings.use_ring_field, s.raw_edges, s.raw_planes);
+  correct_elevation(s.raw_edges, c.preprocess.elevation_correction_deg);
+  correct_elevation(s.raw_planes, c.preprocess.elevation_correction_deg);
   s.edge_filter.filter(s.raw_edges, c.features.edge_leaf_m, result.edges);
   s.plane_filter.filter(s.raw_planes, c.features.plane_leaf_m, result.planes);
   result.features_ms = watch.elapsed_ms();
@@ -68,8 +113,11 @@ OdometryResult Odometry::process(const Scan& scan) {
   if (s.frames == 0) {
     result.T_world_lidar = Eigen::Isometry3d::Identity();
   } else {
-    // Constant-velocity prediction T_k = T_{k-1} (T_{k-2}^-1 T_{k-1}), kept on SO(3).
-    const Eigen::Isometry3d T_pred = orthonormalized(s.T_last * s.T_delta);
+    // Constant-velocity prediction T_k = T_{k-1} (T_{k-2}^-1 T_{k-1})^r, kept on SO(3), where
+    // r = this frame's interval over the last one: after dropped frames (a 1 s gap) the car
+    // has moved ten intervals' worth, and the map match only pulls in a good guess.
+    const Eigen::Isometry3d T_pred =
+        orthonormalized(s.T_last * scaled_motion(s.T_delta, interval_ratio(s.frames >= 2 ? s.delta_dt_s : 0.0, scan.timestamp_s - s.last_stamp_s)));
     const RegistrationResult reg =
         s.registration.align(result.edges, result.planes, s.map, T_pred, s.rounds);
     result.T_world_lidar = orthonormalized(reg.T_world_lidar);
