@@ -38,7 +38,9 @@ TEST(DegenerateScenes, PatrolLapRepeatsExactlyWithASmoothRealisticDrive) {
     double dyaw = yaw_rad(sc.frame_pose(k + 1)) - yaw_rad(sc.frame_pose(k));
     dyaw = std::atan2(std::sin(dyaw), std::cos(dyaw));
     const double yaw_rate = dyaw / 0.1;
-    if (k > 1) EXPECT_LT(std::abs(yaw_rate - prev_yaw_rate) / 0.1, 0.5) << k;  // rad/s^2: no steps
+    if (k > 1) {
+      EXPECT_LT(std::abs(yaw_rate - prev_yaw_rate) / 0.1, 0.5) << k;  // rad/s^2: no steps
+    }
     EXPECT_LT(v * std::abs(yaw_rate), 3.0) << k;                               // lateral m/s^2
     prev_yaw_rate = yaw_rate;
   }
