@@ -9,6 +9,7 @@
 #include <mutex>
 
 #include "bag_source_internal.hpp"
+#include "ros1_bag_check.hpp"
 #include "scfloam/error.hpp"
 
 namespace scfloam {
@@ -20,6 +21,7 @@ class Ros1BagFile final : public BagFile {
     // librosbag also prints its errors through console_bridge; they reach the user as the
     // Error below instead, once.
     console_bridge::setLogLevel(console_bridge::CONSOLE_BRIDGE_LOG_NONE);
+    check_ros1_bag_records(path);  // before librosbag sizes buffers from corrupt lengths
     try {
       bag_.open(path.string(), rosbag::bagmode::Read);
       rosbag::View all(bag_);
