@@ -1,6 +1,8 @@
 // `scfloam run` end to end through the built binary: outputs, errors, exit codes.
 #include <gtest/gtest.h>
 
+#include "cli/run_cli.hpp"
+
 #include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -13,22 +15,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct Outcome {
-  int exit_code = -1;
-  std::string output;  // stdout and stderr
-};
-
-Outcome run_cli(const std::string& args) {
-  const std::string cmd = std::string(SCFLOAM_BINARY_DIR) + "/bin/scfloam " + args + " 2>&1";
-  Outcome out;
-  FILE* pipe = popen(cmd.c_str(), "r");
-  if (!pipe) return out;
-  char buf[4096];
-  while (std::fgets(buf, sizeof buf, pipe)) out.output += buf;
-  const int status = pclose(pipe);
-  out.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return out;
-}
+using scfloam::test::Outcome;
+using scfloam::test::run_cli;
 
 nlohmann::json read_json(const fs::path& path) {
   std::ifstream in(path);

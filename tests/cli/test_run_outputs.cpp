@@ -2,6 +2,8 @@
 // directory, the map files (PCD, PLY, keyframes), --frame, --force, --sensor.
 #include <gtest/gtest.h>
 
+#include "cli/run_cli.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -19,22 +21,8 @@ using namespace scfloam;
 
 namespace {
 
-struct Outcome {
-  int exit_code = -1;
-  std::string output;
-};
-
-Outcome run_cli(const std::string& args) {
-  const std::string cmd = std::string(SCFLOAM_BINARY_DIR) + "/bin/scfloam " + args + " 2>&1";
-  Outcome out;
-  FILE* pipe = popen(cmd.c_str(), "r");
-  if (!pipe) return out;
-  char buf[4096];
-  while (std::fgets(buf, sizeof buf, pipe)) out.output += buf;
-  const int status = pclose(pipe);
-  out.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return out;
-}
+using scfloam::test::Outcome;
+using scfloam::test::run_cli;
 
 // 30 simulated HDL-64 scans as a KITTI directory and the same scans as binary_compressed PCDs
 // with a timestamps file (built once for the suite).
