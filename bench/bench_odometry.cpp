@@ -4,6 +4,9 @@
 // ProcessStep: a full Odometry::process() (features + scan-to-map + map update) per frame over
 // the ten scans, replayed forwards then backwards so the map keeps being extended.
 // Knn: one 5-nearest query of the registration against a map of ten frames.
+// The *_x20 variants run a fixed 20 iterations and switch callgrind's instrumentation on for
+// the timed loop only, for instruction counts of the steady state without the warm-up:
+//   valgrind --tool=callgrind --instr-atstart=no bench_odometry --benchmark_filter=x20/kitti05
 #include <benchmark/benchmark.h>
 
 #include <cstdlib>
@@ -16,6 +19,15 @@
 #include "scfloam/odometry/odometry.hpp"
 #include "scfloam/registration/scan_to_map.hpp"
 #include "scfloam/registration/voxel_filter.hpp"
+
+#if __has_include(<valgrind/callgrind.h>)
+#include <valgrind/callgrind.h>  // no-ops unless run under callgrind
+#define SCFLOAM_INSTR_START() CALLGRIND_START_INSTRUMENTATION
+#define SCFLOAM_INSTR_STOP() CALLGRIND_STOP_INSTRUMENTATION
+#else
+#define SCFLOAM_INSTR_START()
+#define SCFLOAM_INSTR_STOP()
+#endif
 
 namespace {
 using namespace scfloam;
@@ -42,6 +54,7 @@ void BM_Features(benchmark::State& state, const char* seq) {
   VoxelFilter edge_filter, plane_filter;
   FeatureCloud edges, planes, e2, p2;
   std::size_t i = 0;
+  SCFLOAM_INSTR_START();
   for (auto _ : state) {
     const Scan& scan = all[i++ % all.size()];
     extractor.extract(scan.points, false, edges, planes);
@@ -49,6 +62,7 @@ void BM_Features(benchmark::State& state, const char* seq) {
     plane_filter.filter(planes, c.features.plane_leaf_m, p2);
     benchmark::DoNotOptimize(p2.data());
   }
+  SCFLOAM_INSTR_STOP();
   state.counters["edges"] = static_cast<double>(e2.size());
   state.counters["planes"] = static_cast<double>(p2.size());
 }
@@ -64,11 +78,13 @@ void BM_ProcessStep(benchmark::State& state, const char* seq) {
   };
   for (int w = 0; w < 12; ++w) odometry.process(next());
   double features_ms = 0, registration_ms = 0;
+  SCFLOAM_INSTR_START();
   for (auto _ : state) {
     const auto r = odometry.process(next());
     features_ms += r.features_ms;
     registration_ms += r.registration_ms;
   }
+  SCFLOAM_INSTR_STOP();
   state.counters["features_ms"] = features_ms / state.iterations();
   state.counters["registration_ms"] = registration_ms / state.iterations();
 }
@@ -98,6 +114,11 @@ BENCHMARK_CAPTURE(BM_Features, kitti08, "08")->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_ProcessStep, kitti05, "05")->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_ProcessStep, kitti08, "08")->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Knn)->Unit(benchmark::kNanosecond);
+// Fixed workloads for callgrind (see the top).
+BENCHMARK_CAPTURE(BM_Features, x20/kitti05, "05")->Iterations(20)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Features, x20/kitti08, "08")->Iterations(20)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_ProcessStep, x20/kitti05, "05")->Iterations(20)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_ProcessStep, x20/kitti08, "08")->Iterations(20)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
