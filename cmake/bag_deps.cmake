@@ -5,7 +5,9 @@
 #   libraries are found by hand. bag.h includes pluginlib (ROS 2's, under /usr/include/pluginlib)
 #   and through it class_loader, rcutils, rcpputils: their include dirs are added too.
 # - ROS 2: sqlite3; MCAP chunks: zstd and lz4 (frame format).
+# - Our own ROS 1 chunk walk (src/io/ros1_bag_check_chunk.cpp): bz2 and lz4 (frame format).
 find_package(SQLite3 REQUIRED)
+find_package(BZip2 REQUIRED)
 find_package(PkgConfig REQUIRED)
 pkg_check_modules(ZSTD REQUIRED IMPORTED_TARGET libzstd)
 pkg_check_modules(LZ4 REQUIRED IMPORTED_TARGET liblz4)
@@ -26,4 +28,4 @@ endforeach()
 
 add_library(scfloam_bag_deps INTERFACE)
 target_include_directories(scfloam_bag_deps SYSTEM INTERFACE ${_rosbag_include_dirs})
-target_link_libraries(scfloam_bag_deps INTERFACE ${_rosbag_libs} SQLite::SQLite3 PkgConfig::ZSTD PkgConfig::LZ4)
+target_link_libraries(scfloam_bag_deps INTERFACE ${_rosbag_libs} SQLite::SQLite3 BZip2::BZip2 PkgConfig::ZSTD PkgConfig::LZ4)
