@@ -17,6 +17,12 @@ function(scfloam_module room)
   set(SCFLOAM_MODULES ${SCFLOAM_MODULES} ${target} CACHE INTERNAL "")
 endfunction()
 
+# End-to-end and accuracy suites: whole simulated drives through the odometry / loop closure /
+# pipeline, minutes each under the sanitizers. ctest label `long`; scripts/test.sh runs them in
+# the plain build only and the sanitizer stage runs the unit tests (`ctest -LE long`).
+set(SCFLOAM_LONG_TEST_SUITES Pipeline Degenerate LoopSequence LoopClosure SimOdometry
+    CACHE STRING "GoogleTest suites labelled `long` in ctest")
+
 # scfloam_test_suite(<room> LIBS ...): tests/<room>/*.cpp as one GoogleTest program test_<room>.
 function(scfloam_test_suite room)
   cmake_parse_arguments(T "" "" "LIBS" ${ARGN})
@@ -30,5 +36,12 @@ function(scfloam_test_suite room)
   target_compile_definitions(test_${room} PRIVATE
     SCFLOAM_SHARED_DIR="${SCFLOAM_SHARED_DIR}"
     SCFLOAM_BINARY_DIR="${CMAKE_BINARY_DIR}")
-  gtest_discover_tests(test_${room} DISCOVERY_TIMEOUT 60 PROPERTIES TIMEOUT 900)
+  # Suites listed in SCFLOAM_LONG_TEST_SUITES get the ctest label `long`; the rest are the unit
+  # tests. Two discoveries of the same program, split by gtest filter.
+  list(TRANSFORM SCFLOAM_LONG_TEST_SUITES APPEND ".*" OUTPUT_VARIABLE long_patterns)
+  string(JOIN ":" long_filter ${long_patterns})
+  gtest_discover_tests(test_${room} DISCOVERY_TIMEOUT 60 TEST_FILTER "-${long_filter}"
+                       PROPERTIES TIMEOUT 900)
+  gtest_discover_tests(test_${room} DISCOVERY_TIMEOUT 60 TEST_FILTER "${long_filter}"
+                       PROPERTIES TIMEOUT 900 LABELS long)
 endfunction()
