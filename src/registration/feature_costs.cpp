@@ -1,6 +1,11 @@
 #include "scfloam/registration/feature_costs.hpp"
 
+#include <tbb/parallel_for.h>
+
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
 
 namespace scfloam {
 
@@ -82,6 +87,97 @@ bool FeatureCost::Evaluate(double const* const* parameters, double* residuals,
     }
     ++row;
   }
+  return true;
+}
+
+NormalEquationCost::NormalEquationCost(const std::vector<EdgeMatch>& edges,
+                                       const std::vector<PlaneMatch>& planes,
+                                       double huber_delta_m, tbb::task_arena* arena)
+    : edges_(edges), planes_(planes), delta_(huber_delta_m), arena_(arena) {
+  set_num_residuals(7);
+  mutable_parameter_block_sizes()->push_back(7);
+}
+
+void NormalEquationCost::sums(const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
+                              bool with_jacobian, Sums& out) const {
+  // Fixed blocks summed in block order: the same floating-point sums whatever the threads.
+  constexpr std::size_t kBlock = 1024;
+  const std::size_t n_edges = edges_.size(), total = n_edges + planes_.size();
+  const std::size_t n_blocks = (total + kBlock - 1) / kBlock;
+  blocks_.resize(n_blocks);
+  auto run_block = [&](std::size_t b) {
+    Sums& s = blocks_[b];
+    s.H.setZero();
+    s.g.setZero();
+    s.squared_norm = 0;
+    const std::size_t begin = b * kBlock, end = std::min(total, begin + kBlock);
+    for (std::size_t i = begin; i < std::min(end, n_edges); ++i) {
+      Jacobian36 J;
+      Eigen::Vector3d r = edge_residual(edges_[i], R, t, with_jacobian ? &J : nullptr);
+      robustify_huber<3>(delta_, r, with_jacobian ? &J : nullptr);
+      s.squared_norm += r.squaredNorm();
+      if (with_jacobian) {
+        s.H.noalias() += J.transpose() * J;
+        s.g.noalias() += J.transpose() * r;
+      }
+    }
+    for (std::size_t i = std::max(begin, n_edges); i < end; ++i) {
+      Jacobian16 J;
+      Eigen::Matrix<double, 1, 1> r(
+          plane_residual(planes_[i - n_edges], R, t, with_jacobian ? &J : nullptr));
+      robustify_huber<1>(delta_, r, with_jacobian ? &J : nullptr);
+      s.squared_norm += r[0] * r[0];
+      if (with_jacobian) {
+        s.H.noalias() += J.transpose() * J;
+        s.g.noalias() += J.transpose() * r[0];
+      }
+    }
+  };
+  if (arena_ && n_blocks > 1)
+    arena_->execute([&] { tbb::parallel_for(std::size_t{0}, n_blocks, run_block); });
+  else
+    for (std::size_t b = 0; b < n_blocks; ++b) run_block(b);
+  out.H.setZero();
+  out.g.setZero();
+  out.squared_norm = 0;
+  for (const Sums& s : blocks_) {
+    out.H += s.H;
+    out.g += s.g;
+    out.squared_norm += s.squared_norm;
+  }
+}
+
+bool NormalEquationCost::Evaluate(double const* const* parameters, double* residuals,
+                                  double** jacobians) const {
+  const Eigen::Quaterniond q = Eigen::Map<const Eigen::Quaterniond>(parameters[0]).normalized();
+  const Eigen::Matrix3d R = q.toRotationMatrix();
+  const Eigen::Map<const Eigen::Vector3d> t(parameters[0] + 4);
+  double* J = (jacobians && jacobians[0]) ? jacobians[0] : nullptr;  // row-major 7 x 7
+  Sums s;
+  sums(R, t, J != nullptr, s);
+  if (!std::isfinite(s.squared_norm)) return false;
+  std::fill(residuals, residuals + 7, 0.0);
+  if (!J) {  // only the cost is wanted
+    residuals[6] = std::sqrt(s.squared_norm);
+    return true;
+  }
+  if (!s.H.allFinite() || !s.g.allFinite()) return false;
+  Eigen::Map<Eigen::Matrix<double, 7, 7, Eigen::RowMajor>> Jm(J);
+  Jm.setZero();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> es(s.H);
+  const Eigen::Matrix<double, 6, 1> Vg = es.eigenvectors().transpose() * s.g;
+  // g lies in the range of H; directions with a (numerically) zero eigenvalue carry nothing.
+  const double floor = 1e-12 * std::max(es.eigenvalues().maxCoeff(), 0.0);
+  double explained = 0;
+  for (int i = 0; i < 6; ++i) {
+    const double l = es.eigenvalues()[i];
+    if (!(l > floor) || l <= 0) continue;
+    const double sl = std::sqrt(l);
+    Jm.block<1, 6>(i, 0) = sl * es.eigenvectors().col(i).transpose();
+    residuals[i] = Vg[i] / sl;
+    explained += residuals[i] * residuals[i];
+  }
+  residuals[6] = std::sqrt(std::max(0.0, s.squared_norm - explained));
   return true;
 }
 

@@ -39,6 +39,7 @@ void FeatureMap::clear() {
 ScanToMapRegistration::ScanToMapRegistration(const RegistrationConfig& config) : config_(config) {
   if (config.knn < 3 || config.knn > VoxelMap::kMaxK)
     throw Error("registration: knn must be in [3, " + std::to_string(VoxelMap::kMaxK) + "]");
+  if (config.num_threads > 1) arena_ = std::make_unique<tbb::task_arena>(config.num_threads);
 }
 
 namespace {
@@ -147,9 +148,8 @@ void ScanToMapRegistration::find_matches(const FeatureCloud& edges, const Featur
       }
     }
   };
-  if (config_.num_threads > 1) {
-    tbb::task_arena arena(config_.num_threads);
-    arena.execute([&] { tbb::parallel_for(tbb::blocked_range<std::size_t>(0, total, 256), work); });
+  if (arena_) {
+    arena_->execute([&] { tbb::parallel_for(tbb::blocked_range<std::size_t>(0, total, 256), work); });
   } else {
     work(tbb::blocked_range<std::size_t>(0, total));
   }
@@ -278,7 +278,7 @@ RegistrationResult ScanToMapRegistration::align(const FeatureCloud& edges_lidar,
       if (cond.weak() == 6) break;  // nothing is constrained: keep the guess
       if (cond.weak() > 0) subspace = std::make_unique<SubspacePoseManifold>(cond.basis(true));
     }
-    FeatureCost cost(edge_out_, plane_out_, config_.huber_delta_m);
+    NormalEquationCost cost(edge_out_, plane_out_, config_.huber_delta_m, arena_.get());
     ceres::Problem::Options problem_options;
     problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
     problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;

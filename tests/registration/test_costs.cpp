@@ -116,6 +116,79 @@ TEST(FeatureCosts, CeresCostEvaluatesEveryMatchWithTangentJacobian) {
   EXPECT_EQ(jac[2 * 7 + 6], 0.0);
 }
 
+// Random matches, some far enough off for the Huber loss to bend them.
+void random_matches(std::vector<EdgeMatch>& edges, std::vector<PlaneMatch>& planes, int n) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1, 1);
+  auto vec = [&](double s) { return Eigen::Vector3d(s * u(rng), s * u(rng), s * u(rng)); };
+  for (int i = 0; i < n; ++i) {
+    edges.push_back({vec(30), Eigen::Vector3d(120, -35, 4) + vec(30), vec(1).normalized()});
+    planes.push_back({vec(30), vec(1).normalized(), 0.3 * u(rng)});
+  }
+}
+
+TEST(FeatureCosts, NormalEquationCostHasFeatureCostsCostGradientAndGaussNewtonMatrix) {
+  std::vector<EdgeMatch> edges;
+  std::vector<PlaneMatch> planes;
+  random_matches(edges, planes, 1500);  // > one summation block of each kind
+  const FeatureCost full(edges, planes, 0.1);
+  tbb::task_arena arena(2);
+  for (tbb::task_arena* a : {static_cast<tbb::task_arena*>(nullptr), &arena}) {
+    const NormalEquationCost compact(edges, planes, 0.1, a);
+    ASSERT_EQ(compact.num_residuals(), 7);
+    double x[7];
+    pose_to_block(some_pose(), x);
+    const double* params[] = {x};
+    const int rows = full.num_residuals();
+    Eigen::VectorXd r_full(rows);
+    Eigen::Matrix<double, Eigen::Dynamic, 7, Eigen::RowMajor> J_full(rows, 7);
+    double* jf[] = {J_full.data()};
+    ASSERT_TRUE(full.Evaluate(params, r_full.data(), jf));
+    Eigen::Matrix<double, 7, 1> r;
+    Eigen::Matrix<double, 7, 7, Eigen::RowMajor> J;
+    double* jc[] = {J.data()};
+    ASSERT_TRUE(compact.Evaluate(params, r.data(), jc));
+    const double cost = r_full.squaredNorm();
+    EXPECT_NEAR(r.squaredNorm(), cost, 1e-10 * cost);
+    const Eigen::MatrixXd H_full = J_full.transpose() * J_full, H = J.transpose() * J;
+    EXPECT_LT((H - H_full).norm(), 1e-10 * H_full.norm());
+    const Eigen::VectorXd g_full = J_full.transpose() * r_full, g = J.transpose() * r;
+    EXPECT_LT((g - g_full).norm(), 1e-10 * g_full.norm());
+    // Cost alone (the trial steps): the same value.
+    Eigen::Matrix<double, 7, 1> r_only;
+    ASSERT_TRUE(compact.Evaluate(params, r_only.data(), nullptr));
+    EXPECT_NEAR(r_only.squaredNorm(), cost, 1e-10 * cost);
+  }
+}
+
+TEST(FeatureCosts, NormalEquationCostOfAFloorAloneIsRankDeficientButExact) {
+  // Plane matches on z = 0 only: x, y and yaw are unconstrained (J^T J has rank 3).
+  std::vector<EdgeMatch> edges;
+  std::vector<PlaneMatch> planes;
+  for (int i = 0; i < 50; ++i)
+    planes.push_back({Eigen::Vector3d(i % 7 - 3.0, i / 7 - 3.0, -1.7), Eigen::Vector3d::UnitZ(), 0.0});
+  const NormalEquationCost compact(edges, planes, 0.1);
+  const FeatureCost full(edges, planes, 0.1);
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.translation() = Eigen::Vector3d(3, 4, 1.75);
+  T.linear() = so3_exp(Eigen::Vector3d(0.01, -0.02, 0.5));
+  double x[7];
+  pose_to_block(T, x);
+  const double* params[] = {x};
+  Eigen::VectorXd r_full(50);
+  Eigen::Matrix<double, Eigen::Dynamic, 7, Eigen::RowMajor> J_full(50, 7);
+  double* jf[] = {J_full.data()};
+  ASSERT_TRUE(full.Evaluate(params, r_full.data(), jf));
+  Eigen::Matrix<double, 7, 1> r;
+  Eigen::Matrix<double, 7, 7, Eigen::RowMajor> J;
+  double* jc[] = {J.data()};
+  ASSERT_TRUE(compact.Evaluate(params, r.data(), jc));
+  EXPECT_TRUE(r.allFinite());
+  EXPECT_NEAR(r.squaredNorm(), r_full.squaredNorm(), 1e-12);
+  EXPECT_LT((J.transpose() * r - J_full.transpose() * r_full).norm(), 1e-9);
+  EXPECT_LT((J.transpose() * J - J_full.transpose() * J_full).norm(), 1e-9);
+}
+
 TEST(PoseManifold, PlusMinusRoundTripAndStaysOnSO3) {
   PoseManifold m;
   double x[7], y[7], back[6];

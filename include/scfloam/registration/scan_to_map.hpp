@@ -5,6 +5,7 @@
 
 #include <Eigen/Geometry>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "scfloam/config.hpp"
@@ -72,6 +73,7 @@ class ScanToMapRegistration {
                     const Eigen::Isometry3d& T_world_lidar, bool first_round);
 
   RegistrationConfig config_;
+  std::unique_ptr<tbb::task_arena> arena_;  // num_threads > 1: search and cost evaluation
   std::vector<EdgeMatch> edge_all_, edge_out_;
   std::vector<PlaneMatch> plane_all_, plane_out_;
   std::vector<char> edge_ok_, plane_ok_;
