@@ -77,6 +77,10 @@ struct RegistrationConfig {
   // Solution remapping: along the weak eigenvectors (of either block) the solve keeps the
   // constant-velocity prediction and moves only in the well-constrained directions.
   bool degeneracy_fallback = true;
+  // Odometry: when the prediction is a guess (the second frame, from zero velocity; the frame
+  // after a gap) a coarse pass first aligns the scan to the previous frame's features with
+  // this search radius, wider than max_neighbor_dist_m's basin (0 = no coarse pass).
+  double coarse_neighbor_dist_m = 3.0;
   int num_threads = 2;               // TBB correspondence search and Ceres evaluation
 };
 

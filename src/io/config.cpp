@@ -61,6 +61,7 @@ std::vector<Binding> bindings(SlamConfig& c) {
       {reg, "degeneracy_min_rotation_eigenvalue",
        &o.registration.degeneracy_min_rotation_eigenvalue},
       {reg, "degeneracy_fallback", &o.registration.degeneracy_fallback},
+      {reg, "coarse_neighbor_dist_m", &o.registration.coarse_neighbor_dist_m},
       {reg, "num_threads", &o.registration.num_threads},
       {map, "edge_spacing_m", &o.map.edge_spacing_m},
       {map, "plane_spacing_m", &o.map.plane_spacing_m},

@@ -29,6 +29,7 @@ struct Odometry::Impl {
 
   std::vector<LidarPoint> deskewed;
   FeatureCloud raw_edges, raw_planes;
+  FeatureCloud last_edges, last_planes;  // the previous frame's features, for the coarse pass
   std::size_t frames = 0;
   int rounds;
   Eigen::Isometry3d T_last = Eigen::Isometry3d::Identity();  // T_world_lidar of frame k-1
@@ -76,6 +77,32 @@ void correct_elevation(FeatureCloud& points, double angle_deg) {
   }
 }
 
+// The scan aligned to the previous frame alone with a wide search radius, from `T_pred`: the
+// local map's radius (max_neighbor_dist_m, ~1 m) is the basin of the fine solve, and a guess
+// made without a velocity (frame 1 starts from standing still; a car at 12 m/s is 1.2 m on)
+// or extrapolated over a gap can lie outside it. Wide matches are coarse, so only the start
+// of the fine solve comes from here.
+Eigen::Isometry3d coarse_alignment(const OdometryConfig& c, const FeatureCloud& last_edges,
+                                   const FeatureCloud& last_planes,
+                                   const Eigen::Isometry3d& T_world_last,
+                                   const OdometryResult& frame, const Eigen::Isometry3d& T_pred) {
+  if (!(c.registration.coarse_neighbor_dist_m > c.registration.max_neighbor_dist_m))
+    return T_pred;
+  RegistrationConfig coarse = c.registration;
+  coarse.max_neighbor_dist_m = c.registration.coarse_neighbor_dist_m;
+  coarse.degeneracy_fallback = false;
+  LocalMapConfig coarse_map = c.map;
+  // Cells are the search radius wide: keep the density of the fine map's cells.
+  const double area_ratio = std::pow(coarse.max_neighbor_dist_m / c.registration.max_neighbor_dist_m, 2);
+  coarse_map.max_points_per_cell = static_cast<int>(std::ceil(c.map.max_points_per_cell * area_ratio));
+  FeatureMap map(coarse, coarse_map);
+  map.insert(last_edges, last_planes, T_world_last);
+  ScanToMapRegistration registration(coarse);
+  return registration
+      .align(frame.edges, frame.planes, map, T_pred, c.registration.outer_iterations_initial)
+      .T_world_lidar;
+}
+
 }  // namespace
 
 Odometry::Odometry(const OdometryConfig& config) : impl_(std::make_unique<Impl>(config)) {
@@ -116,10 +143,17 @@ OdometryResult Odometry::process(const Scan& scan) {
     // Constant-velocity prediction T_k = T_{k-1} (T_{k-2}^-1 T_{k-1})^r, kept on SO(3), where
     // r = this frame's interval over the last one: after dropped frames (a 1 s gap) the car
     // has moved ten intervals' worth, and the map match only pulls in a good guess.
-    const Eigen::Isometry3d T_pred =
-        orthonormalized(s.T_last * scaled_motion(s.T_delta, interval_ratio(s.frames >= 2 ? s.delta_dt_s : 0.0, scan.timestamp_s - s.last_stamp_s)));
+    const double ratio =
+        interval_ratio(s.frames >= 2 ? s.delta_dt_s : 0.0, scan.timestamp_s - s.last_stamp_s);
+    const Eigen::Isometry3d T_pred = orthonormalized(s.T_last * scaled_motion(s.T_delta, ratio));
+    // After a gap the prediction is extrapolated over many intervals and may be a metre off:
+    // give this frame the first frame's rounds, so the matches can walk the pose in from
+    // there (each round re-matches within max_neighbor_dist_m of the current pose).
+    if (ratio >= 1.5) s.rounds = std::max(s.rounds, c.registration.outer_iterations_initial);
+    const Eigen::Isometry3d T_start =
+        s.frames == 1 || ratio >= 1.5 ? coarse_alignment(c, s.last_edges, s.last_planes, s.T_last, result, T_pred) : T_pred;
     const RegistrationResult reg =
-        s.registration.align(result.edges, result.planes, s.map, T_pred, s.rounds);
+        s.registration.align(result.edges, result.planes, s.map, T_start, s.rounds);
     result.T_world_lidar = orthonormalized(reg.T_world_lidar);
     result.degenerate = reg.degenerate;
     result.registration_rounds = reg.rounds;
@@ -128,6 +162,8 @@ OdometryResult Odometry::process(const Scan& scan) {
     result.mean_residual_m = reg.mean_residual_m;
     result.min_translation_eigenvalue = reg.translation_eigenvalues[0];
     result.min_rotation_eigenvalue = reg.rotation_eigenvalues[0];
+    result.translation_eigenvalues = reg.translation_eigenvalues;
+    result.rotation_eigenvalues = reg.rotation_eigenvalues;
     result.weak_directions =
         reg.fallback_applied ? reg.weak_rotation_dirs + reg.weak_translation_dirs : 0;
     s.rounds = std::max(c.registration.outer_iterations, s.rounds - 1);
@@ -139,6 +175,10 @@ OdometryResult Odometry::process(const Scan& scan) {
   // pull it in (docs/odometry.md, "First frame").
   if (s.frames == 0) s.map.insert(s.raw_edges, s.raw_planes, result.T_world_lidar);
   else s.map.insert(result.edges, result.planes, result.T_world_lidar);
+  s.last_edges.assign(s.frames == 0 ? s.raw_edges.begin() : result.edges.begin(),
+                      s.frames == 0 ? s.raw_edges.end() : result.edges.end());
+  s.last_planes.assign(s.frames == 0 ? s.raw_planes.begin() : result.planes.begin(),
+                       s.frames == 0 ? s.raw_planes.end() : result.planes.end());
   // Dropping far cells walks the whole map: do it every 10 m of travel, not every frame.
   const Eigen::Vector3d position = result.T_world_lidar.translation();
   if ((position - s.last_cleanup_position).norm() > 10.0) {

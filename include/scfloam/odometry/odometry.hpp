@@ -26,6 +26,9 @@ struct OdometryResult {
   double mean_residual_m = 0;
   double min_translation_eigenvalue = 0;  // of J^T J; see RegistrationConfig
   double min_rotation_eigenvalue = 0;
+  // All eigenvalues of the two blocks (ascending), for diagnostics of the degeneracy test.
+  Eigen::Vector3d translation_eigenvalues = Eigen::Vector3d::Zero();
+  Eigen::Vector3d rotation_eigenvalues = Eigen::Vector3d::Zero();
   // Weak directions (rotation + translation) where the pose kept the constant-velocity
   // prediction (RegistrationConfig::degeneracy_fallback); 6 when nothing matched.
   int weak_directions = 0;
