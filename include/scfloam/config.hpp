@@ -77,6 +77,11 @@ struct RegistrationConfig {
   // Solution remapping: along the weak eigenvectors (of either block) the solve keeps the
   // constant-velocity prediction and moves only in the well-constrained directions.
   bool degeneracy_fallback = true;
+  // Relative test (registration/degeneracy.hpp): an eigenvalue of the translation (rotation)
+  // block below this fraction of the block's largest is weak. Measured: simulated city and
+  // KITTI-05-like >= 0.27 and >= 0.15; inside the tunnel 0.17-0.2 and 0.017-0.05.
+  double degeneracy_min_translation_ratio = 0.2;
+  double degeneracy_min_rotation_ratio = 0.05;
   // Odometry: when the prediction is a guess (the second frame, from zero velocity; the frame
   // after a gap) a coarse pass first aligns the scan to the previous frame's features with
   // this search radius, wider than max_neighbor_dist_m's basin (0 = no coarse pass).

@@ -61,6 +61,8 @@ std::vector<Binding> bindings(SlamConfig& c) {
       {reg, "degeneracy_min_rotation_eigenvalue",
        &o.registration.degeneracy_min_rotation_eigenvalue},
       {reg, "degeneracy_fallback", &o.registration.degeneracy_fallback},
+      {reg, "degeneracy_min_translation_ratio", &o.registration.degeneracy_min_translation_ratio},
+      {reg, "degeneracy_min_rotation_ratio", &o.registration.degeneracy_min_rotation_ratio},
       {reg, "coarse_neighbor_dist_m", &o.registration.coarse_neighbor_dist_m},
       {reg, "num_threads", &o.registration.num_threads},
       {map, "edge_spacing_m", &o.map.edge_spacing_m},

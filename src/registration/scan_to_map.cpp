@@ -11,6 +11,7 @@
 #include <memory>
 
 #include "scfloam/error.hpp"
+#include "scfloam/registration/degeneracy.hpp"
 #include "scfloam/registration/pose_manifold.hpp"
 #include "scfloam/se3.hpp"
 
@@ -194,39 +195,6 @@ Matrix6 hessian_of(const std::vector<EdgeMatch>& edges, const std::vector<PlaneM
   return H;
 }
 
-// Eigen-decomposition of the rotation and translation blocks (ascending) and how many
-// eigenvalues of each fall below their threshold. The blocks are analysed apart because
-// their units differ; PoseManifold's rotation about the sensor keeps them nearly decoupled.
-struct Conditioning {
-  Eigen::Vector3d rot_values, tra_values;
-  Eigen::Matrix3d rot_vectors, tra_vectors;
-  int weak_rot = 0, weak_tra = 0;
-
-  Conditioning(const Matrix6& H, const RegistrationConfig& config) {
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> rot(H.topLeftCorner<3, 3>());
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> tra(H.bottomRightCorner<3, 3>());
-    rot_values = rot.eigenvalues();
-    rot_vectors = rot.eigenvectors();
-    tra_values = tra.eigenvalues();
-    tra_vectors = tra.eigenvectors();
-    for (int i = 0; i < 3; ++i) {
-      weak_rot += rot_values[i] < config.degeneracy_min_rotation_eigenvalue;
-      weak_tra += tra_values[i] < config.degeneracy_min_eigenvalue;
-    }
-  }
-  int weak() const { return weak_rot + weak_tra; }
-
-  // Orthonormal 6 x m basis of the well-constrained (strong) or weak tangent directions.
-  Basis6 basis(bool strong) const {
-    const int nr = strong ? 3 - weak_rot : weak_rot, nt = strong ? 3 - weak_tra : weak_tra;
-    Basis6 B = Basis6::Zero(6, nr + nt);
-    const int r0 = strong ? weak_rot : 0, t0 = strong ? weak_tra : 0;
-    for (int i = 0; i < nr; ++i) B.block<3, 1>(0, i) = rot_vectors.col(r0 + i);
-    for (int i = 0; i < nt; ++i) B.block<3, 1>(3, nr + i) = tra_vectors.col(t0 + i);
-    return B;
-  }
-};
-
 // Ends a Ceres solve once an accepted step is smaller than `tolerance` (tangent norm, rad and
 // m): further iterations of the round would not change the pose at the scale that matters,
 // and the next round re-matches anyway. Ceres' own parameter_tolerance is relative to the
@@ -273,7 +241,7 @@ RegistrationResult ScanToMapRegistration::align(const FeatureCloud& edges_lidar,
     // (they would follow noise, and through the nonlinearity disturb the other directions).
     std::unique_ptr<SubspacePoseManifold> subspace;
     if (config_.degeneracy_fallback) {
-      const Conditioning cond(
+      const Degeneracy cond(
           hessian_of(edge_out_, plane_out_, block_to_pose(pose), 0.0, nullptr), config_);
       if (cond.weak() == 6) break;  // nothing is constrained: keep the guess
       if (cond.weak() > 0) subspace = std::make_unique<SubspacePoseManifold>(cond.basis(true));
@@ -318,7 +286,7 @@ RegistrationResult ScanToMapRegistration::align(const FeatureCloud& edges_lidar,
   result.hessian = n < kMinMatches ? Matrix6::Zero()
                                    : hessian_of(edge_out_, plane_out_, block_to_pose(pose),
                                                 config_.huber_delta_m, &sum_dist);
-  const Conditioning cond(
+  const Degeneracy cond(
       n < kMinMatches ? Matrix6::Zero()
                       : hessian_of(edge_out_, plane_out_, block_to_pose(pose), 0.0, nullptr),
       config_);
