@@ -91,6 +91,7 @@ std::vector<Binding> bindings(SlamConfig& c) {
       {det, "gate_base_m", &d.gate_base_m},
       {det, "gate_keyframes_per_m", &d.gate_keyframes_per_m},
       {det, "fixed_gate_m", &d.fixed_gate_m},
+      {det, "gate_drift_fraction", &d.gate_drift_fraction},
   });
   auto& l = c.loop_registration;
   const std::string lr = "loop_registration";
@@ -127,6 +128,9 @@ std::vector<Binding> bindings(SlamConfig& c) {
       {pl, "rebuild_map_after_loop", &p.rebuild_map_after_loop},
       {pl, "map_rebuild_min_shift_m", &p.map_rebuild_min_shift_m},
       {pl, "raw_leaf_m", &p.raw_leaf_m},
+      {pl, "resident_keyframes", &p.resident_keyframes},
+      {pl, "spill_dir", &p.spill_dir},
+      {pl, "map_rebuild_cell_m", &p.map_rebuild_cell_m},
   });
   return table;
 }
@@ -204,9 +208,12 @@ void check_ranges(const SlamConfig& c, const std::filesystem::path& path) {
   require(d.descriptor.max_radius_m > 0, "loop_detection.descriptor.max_radius_m", "> 0");
   require(d.num_candidates >= 1, "loop_detection.num_candidates", ">= 1");
   require(d.tree_rebuild_every >= 1, "loop_detection.tree_rebuild_every", ">= 1");
+  require(d.gate_drift_fraction >= 0, "loop_detection.gate_drift_fraction", ">= 0");
   require(c.loop_registration.icp_leaf_m > 0, "loop_registration.icp_leaf_m", "> 0");
   require(c.pipeline.queue_capacity >= 1, "pipeline.queue_capacity", ">= 1");
   require(c.pipeline.raw_leaf_m > 0, "pipeline.raw_leaf_m", "> 0");
+  require(c.pipeline.resident_keyframes >= 0, "pipeline.resident_keyframes", ">= 0");
+  require(c.pipeline.map_rebuild_cell_m >= 0, "pipeline.map_rebuild_cell_m", ">= 0");
 }
 
 }  // namespace

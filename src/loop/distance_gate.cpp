@@ -1,5 +1,6 @@
 #include "scfloam/loop/distance_gate.hpp"
 
+#include <limits>
 #include <string>
 
 #include "scfloam/error.hpp"
@@ -22,6 +23,9 @@ DistanceGate DistanceGate::adaptive(double base_m, double keyframes_per_m) {
 DistanceGate DistanceGate::fixed(double threshold_m) { return DistanceGate(false, threshold_m, 0.0); }
 
 DistanceGate DistanceGate::from_config(const LoopDetectionConfig& config) {
+  // The path gate needs the pose graph: the closure stage applies it (path_gate.hpp).
+  if (config.adaptive_gate && config.gate_drift_fraction > 0.0)
+    return fixed(std::numeric_limits<double>::infinity());
   return config.adaptive_gate ? adaptive(config.gate_base_m, config.gate_keyframes_per_m)
                               : fixed(config.fixed_gate_m);
 }

@@ -42,10 +42,34 @@ LoopMatch LoopClosure::register_features(const KeyframeView& current, std::size_
                                 config_.odometry.registration);
 }
 
-bool LoopClosure::add(const KeyframePtr& keyframe, const LoopQuery& query) {
+void LoopClosure::apply_path_gate(LoopQuery& query, std::size_t current_kf) {
+  std::vector<std::size_t> loop_kfs;
+  for (const LoopCandidate& c : query.evaluated)
+    if (c.verdict != LoopVerdict::kRejectedScore) loop_kfs.push_back(static_cast<std::size_t>(c.loop_kf));
+  if (loop_kfs.empty()) return;
+  paths_.clear_loops();
+  for (const PoseGraphEdge& e : graph_.edges())
+    if (e.is_loop && e.active) paths_.add_loop(e.from, e.to);
+  const std::vector<double> path_m = paths_.from(current_kf, loop_kfs);
+  const LoopDetectionConfig& d = config_.loop_detection;
+  std::size_t next = 0;
+  const Eigen::Isometry3d T_world_current = graph_.pose(current_kf);
+  regate(
+      query,
+      [&](const LoopCandidate& c) {
+        return DistanceGate::distance_m(graph_.pose(static_cast<std::size_t>(c.loop_kf)), T_world_current);
+      },
+      [&](const LoopCandidate&) { return d.gate_base_m + d.gate_drift_fraction * path_m[next++]; });
+}
+
+bool LoopClosure::add(const KeyframePtr& keyframe, const LoopQuery& detected) {
   const std::size_t k = keyframe->index;
   graph_.add_node(store_.current_pose(k));
   if (k > 0) graph_.add_odometry_edge(k - 1, k, keyframe->T_prev_current, config_.pose_graph);
+  paths_.add_keyframe(keyframe->T_prev_current.translation().norm());
+  LoopQuery query = detected;
+  if (config_.loop_detection.adaptive_gate && config_.loop_detection.gate_drift_fraction > 0.0)
+    apply_path_gate(query, k);
   const std::optional<std::size_t> row = log_.add(query);
   if (!query.best || !row) return false;
 

@@ -13,6 +13,7 @@
 #include "scfloam/loop/loop_detector.hpp"
 #include "scfloam/loop/loop_registration.hpp"
 #include "scfloam/loop/loops_csv.hpp"
+#include "scfloam/loop/path_gate.hpp"
 
 namespace scfloam {
 
@@ -37,6 +38,9 @@ class LoopClosure {
                                           std::size_t& loop_index) const;
   // Logs the loops a solve switched off and hands the poses to the store.
   void publish(const PoseGraphReport& report);
+  // The gate in the graph (loop_detection.gate_drift_fraction > 0): distances under the
+  // optimized poses, uncertainty growing with the graph path between the two keyframes.
+  void apply_path_gate(LoopQuery& query, std::size_t current_kf);
   LoopMatch register_features(const KeyframeView& current, std::size_t loop_kf, std::size_t limit,
                               double sc_yaw_rad);
 
@@ -44,6 +48,7 @@ class LoopClosure {
   LoopRegistrationMethod method_;
   KeyframeStore& store_;
   PoseGraph graph_;
+  GraphPathLengths paths_;  // keyframe chain + accepted loops, for the path gate
   LoopLog log_;
   std::unique_ptr<LoopSubmap> submap_;  // feature method: reused across consecutive loops
   std::vector<std::size_t> loop_rows_;  // loops.csv row of each loop edge, in edge order

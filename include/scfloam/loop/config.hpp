@@ -38,6 +38,10 @@ struct LoopDetectionConfig {
   bool adaptive_gate = true;
   double gate_base_m = 20.0;
   double gate_keyframes_per_m = 40.0;  // the paper's n
+  // > 0 replaces the paper's k/n term (adaptive gate only) by drift_fraction * L, L being the
+  // shortest path linking the two keyframes in the pose graph (through accepted loops), with
+  // the distance under the optimized poses (scfloam/loop/path_gate.hpp). 0 = the paper's gate.
+  double gate_drift_fraction = 0.0;
   // The baseline's fixed gate: 60 m, as the paper's public code uses for its 16-beam variant
   // (SC-A-LOAM itself has none: set 1e9 for that).
   double fixed_gate_m = 60.0;
