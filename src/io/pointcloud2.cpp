@@ -94,7 +94,8 @@ struct TimeRule {
 TimeRule choose_time_rule(const PointCloud2View& cloud, const PointField& ft, bool swap) {
   constexpr double kMaxScanSpan = 1.5;  // seconds: slower than any spinning LiDAR's sweep
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-  for (std::size_t r = 0; r < cloud.height; ++r)
+  // width 0: no rows to walk (a fuzzed cloud of 0 x 4e9 points hung here).
+  for (std::size_t r = 0; r < cloud.height && cloud.width > 0; ++r)
     for (std::size_t c = 0; c < cloud.width; ++c) {
       const double t = read_value(cloud.data + r * cloud.row_step + c * cloud.point_step + ft.offset,
                                   ft.datatype, swap);
@@ -189,7 +190,7 @@ Scan pointcloud2_to_scan(const PointCloud2View& cloud, const std::string& where)
   const TimeRule time_rule = ft ? choose_time_rule(cloud, *ft, swap) : TimeRule{};
   scan.has_time = time_rule.valid;
 
-  for (std::size_t r = 0; r < height; ++r) {
+  for (std::size_t r = 0; r < height && width > 0; ++r) {  // width 0: no rows to walk
     const std::uint8_t* row = cloud.data + r * row_step;
     for (std::size_t c = 0; c < width; ++c) {
       const std::uint8_t* p = row + c * point_step;
