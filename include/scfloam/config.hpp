@@ -117,6 +117,13 @@ struct PipelineConfig {
   // travelled a fifth of the map radius since the last rebuild. 0: rebuild after every loop.
   double map_rebuild_min_shift_m = 0.05;
   double raw_leaf_m = 0.4;         // raw keyframe clouds (baseline descriptor, ICP) downsampling
+  // Keyframes whose clouds stay in memory; the least recently used beyond are spilled to a
+  // file in spill_dir (empty: the temp folder) and read back when needed. 0: keep all.
+  int resident_keyframes = 2000;
+  std::string spill_dir;
+  // Map rebuild after a correction: of the keyframes within the map radius, only the newest
+  // per cube of this size (m) is used, so revisits do not pile up. 0: every keyframe.
+  double map_rebuild_cell_m = 1.0;
 };
 
 struct SlamConfig {
