@@ -1,17 +1,27 @@
 #!/usr/bin/env bash
 # Fuzzes every reader: builds build-fuzz (clang, libFuzzer + ASan + UBSan) and runs each
-# fuzz/<name>_fuzz target for SECONDS_PER_TARGET seconds (default 10; CI uses 10, longer
-# sessions 300+). Seeds: fuzz/corpus/<name>/ plus samples cut at run time from ../shared/data
-# and config/. The growing corpus stays in build-fuzz/fuzz-corpus/<name>/ between runs.
+# fuzz/<name>_fuzz target for SECONDS_PER_TARGET seconds (default 10).
+# Usage: scripts/fuzz.sh [SECONDS_PER_TARGET] [TARGET...]
+#
+# Two uses:
+# - CI (scripts/test.sh sets SCFLOAM_FUZZ_SEED=1): reproducible. libFuzzer runs with -seed=N and
+#   starts from a fresh corpus holding only the seeds (build-fuzz/fuzz-corpus-seed/<name>/,
+#   emptied first), so what it tries depends on the sources, ../shared and N alone: a failed CI
+#   run is re-run with the command the summary prints (given at least as many seconds).
+# - Bench (`bash scripts/fuzz.sh 300`, no SCFLOAM_FUZZ_SEED): libFuzzer picks the seed (printed
+#   in the summary) and the corpus keeps growing in build-fuzz/fuzz-corpus/<name>/ between runs.
+#   Results: docs/robustness.md.
+# Seeds: fuzz/corpus/<name>/ plus samples cut at run time from ../shared/data and config/.
+# Before fuzzing, every saved crash input (tests/io/fuzz_regressions/<name>/) is replayed once.
 # A crash leaves its input in build-fuzz/fuzz-crashes/<name>/ and makes this script fail:
 # fix the reader and copy the input to tests/io/fuzz_regressions/<name>/ (replayed by test_io).
-# Usage: scripts/fuzz.sh [SECONDS_PER_TARGET] [TARGET...]
 set -euo pipefail
 seconds="${1:-10}"
 shift || true
 cd "$(dirname "$0")/.."
 shared="${SCFLOAM_SHARED_DIR:-$(cd .. && pwd)/shared}"
 build="${SCFLOAM_FUZZ_BUILD:-build-fuzz}"
+seed="${SCFLOAM_FUZZ_SEED:-}"
 
 targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then
@@ -69,23 +79,39 @@ seed_from_shared() {
 }
 
 summary="$build/fuzz-summary.txt"
-printf "%-14s %8s %10s %10s %7s %7s %8s  %s\n" target seconds execs execs/s cov ft corpus result >"$summary"
+printf "%-14s %8s %10s %10s %7s %7s %8s %11s  %s\n" target seconds execs execs/s cov ft corpus seed result >"$summary"
 failed=0
+limits=(-timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=2048)
 for name in "${targets[@]}"; do
-  corpus="$build/fuzz-corpus/$name" crashes="$build/fuzz-crashes/$name"
-  mkdir -p "$corpus" "$crashes"
+  fuzzer="$build/bin/${name}_fuzz" crashes="$build/fuzz-crashes/$name" log="$build/fuzz-$name.log"
+  mkdir -p "$crashes"
+  # -timeout: an input taking longer than 10 s is a hang; -rss_limit_mb / -malloc_limit_mb: a
+  # 4 GB size field that allocates is a finding, not an out-of-memory of the machine.
+  regressions=(tests/io/fuzz_regressions/"$name"/*)
+  if [ -e "${regressions[0]}" ] &&
+     ! "$fuzzer" "${limits[@]}" "${regressions[@]}" >"$build/fuzz-$name-regressions.log" 2>&1; then
+    printf "%-14s %8s %10s %10s %7s %7s %8s %11s  %s\n" "$name" 0 "${#regressions[@]}" - - - - - \
+      "REGRESSION (see $build/fuzz-$name-regressions.log)" >>"$summary"
+    failed=1
+    continue
+  fi
+  if [ -n "$seed" ]; then
+    corpus="$build/fuzz-corpus-seed/$name"
+    rm -rf "$corpus"
+    seed_args=(-seed="$seed")
+  else
+    corpus="$build/fuzz-corpus/$name"
+    seed_args=()
+  fi
+  mkdir -p "$corpus"
   seed_from_shared "$name" "$corpus"
   seeds=()
   [ -d "fuzz/corpus/$name" ] && seeds+=("fuzz/corpus/$name")
-  log="$build/fuzz-$name.log"
-  echo "fuzz: $name for ${seconds}s"
+  echo "fuzz: $name for ${seconds}s${seed:+ (seed $seed)}"
   result=ok
   max_len=16384
   case "$name" in ros1_bag | ros2_sqlite | mcap) max_len=65536 ;; esac
-  # -timeout: an input taking longer than 10 s is a hang; -rss_limit_mb: a 4 GB size field
-  # that allocates is a finding, not an out-of-memory of the machine.
-  if ! "$build/bin/${name}_fuzz" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
-      -malloc_limit_mb=2048 \
+  if ! "$fuzzer" "${seed_args[@]}" -max_total_time="$seconds" "${limits[@]}" \
       -max_len="$max_len" -print_final_stats=1 -artifact_prefix="$crashes/" \
       "$corpus" "${seeds[@]}" >"$log" 2>&1; then
     result="CRASH (see $log and $crashes/)"
@@ -95,9 +121,13 @@ for name in "${targets[@]}"; do
   execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -n 1)
   cov=$(grep -oE 'cov: [0-9]+' "$log" | tail -n 1 | cut -d' ' -f2)
   ft=$(grep -oE 'ft: [0-9]+' "$log" | tail -n 1 | cut -d' ' -f2)
-  printf "%-14s %8s %10s %10s %7s %7s %8s  %s\n" "$name" "$seconds" "${execs:-?}" \
+  used_seed=$(sed -n 's/^INFO: Seed: *//p' "$log" | head -n 1)
+  printf "%-14s %8s %10s %10s %7s %7s %8s %11s  %s\n" "$name" "$seconds" "${execs:-?}" \
     "$(( ${execs:-0} / (seconds > 0 ? seconds : 1) ))" "${cov:-?}" "${ft:-?}" \
-    "$(ls "$corpus" | wc -l)" "$result" >>"$summary"
+    "$(ls "$corpus" | wc -l)" "${used_seed:-?}" "$result" >>"$summary"
 done
 cat "$summary"
+if [ "$failed" = 1 ] && [ -n "$seed" ]; then
+  echo "fuzz: to re-run this exactly: SCFLOAM_FUZZ_SEED=$seed bash scripts/fuzz.sh $seconds ${targets[*]}"
+fi
 exit $failed
