@@ -100,6 +100,7 @@ std::vector<Binding> bindings(SlamConfig& c) {
       {lr, "submap_reuse_keyframes", &l.submap_reuse_keyframes},
       {lr, "coarse_radius_m", &l.coarse_radius_m},
       {lr, "coarse_rounds", &l.coarse_rounds},
+      {lr, "fine_first", &l.fine_first},
       {lr, "rounds", &l.rounds},
       {lr, "min_inlier_fraction", &l.min_inlier_fraction},
       {lr, "max_mean_residual_m", &l.max_mean_residual_m},

@@ -50,18 +50,35 @@ LoopSubmap::LoopSubmap(const std::vector<KeyframeView>& keyframes, std::size_t a
     : first_(first_keyframe),
       last_(first_keyframe + keyframes.size() - 1),
       anchor_(first_keyframe + anchor),
-      coarse_(coarse_registration(config, registration),
-              coarse_map_config(config, registration, map_config)),
+      coarse_registration_(coarse_registration(config, registration)),
+      coarse_map_(coarse_map_config(config, registration, map_config)),
       fine_(registration, map_config) {
   const Eigen::Isometry3d T_anchor_world = keyframes.at(anchor).T_world_lidar.inverse();
-  static const FeatureCloud kEmpty;
+  const auto append = [](const FeatureCloud* cloud, const Eigen::Isometry3f& T, FeatureCloud& out) {
+    if (cloud == nullptr) return;
+    for (const Eigen::Vector3f& p : *cloud) out.push_back(T * p);
+  };
+  std::size_t edges = 0, planes = 0;
   for (const auto& kf : keyframes) {
-    const Eigen::Isometry3d T_anchor_kf = T_anchor_world * kf.T_world_lidar;
-    const FeatureCloud& edges = kf.edges ? *kf.edges : kEmpty;
-    const FeatureCloud& planes = kf.planes ? *kf.planes : kEmpty;
-    coarse_.insert(edges, planes, T_anchor_kf);
-    fine_.insert(edges, planes, T_anchor_kf);
+    edges += kf.edges ? kf.edges->size() : 0;
+    planes += kf.planes ? kf.planes->size() : 0;
   }
+  edges_anchor_.reserve(edges);
+  planes_anchor_.reserve(planes);
+  for (const auto& kf : keyframes) {
+    const Eigen::Isometry3f T_anchor_kf = (T_anchor_world * kf.T_world_lidar).cast<float>();
+    append(kf.edges, T_anchor_kf, edges_anchor_);
+    append(kf.planes, T_anchor_kf, planes_anchor_);
+  }
+  fine_.insert(edges_anchor_, planes_anchor_, Eigen::Isometry3d::Identity());
+}
+
+const FeatureMap& LoopSubmap::coarse() const {
+  if (!coarse_) {
+    coarse_.emplace(coarse_registration_, coarse_map_);
+    coarse_->insert(edges_anchor_, planes_anchor_, Eigen::Isometry3d::Identity());
+  }
+  return *coarse_;
 }
 
 LoopMatch register_loop_features(const KeyframeView& current, const LoopSubmap& submap,
@@ -80,13 +97,21 @@ LoopMatch register_loop_features(const KeyframeView& current, const LoopSubmap& 
   const Eigen::Isometry3d T_anchor_loop = T_world_anchor.inverse() * T_world_loop;
   ScanToMapRegistration coarse_solver(coarse_registration(config, registration));
   ScanToMapRegistration fine_solver(registration);
-  for (const Eigen::Isometry3d& T_loop_guess :
-       loop_initial_guesses(T_world_loop, current.T_world_lidar, sc_yaw_rad)) {
-    const RegistrationResult rough = coarse_solver.align(
-        *current.edges, *current.planes, submap.coarse(), T_anchor_loop * T_loop_guess,
-        config.coarse_rounds);
+  const std::vector<Eigen::Isometry3d> guesses =
+      loop_initial_guesses(T_world_loop, current.T_world_lidar, sc_yaw_rad);
+  // Attempt 0 (fine_first): the fine stage alone from the pose guess; then coarse to fine from
+  // each guess.
+  for (std::size_t attempt = config.fine_first ? 0 : 1; attempt <= guesses.size(); ++attempt) {
+    const bool fine_only = attempt == 0;
+    const Eigen::Isometry3d start = T_anchor_loop * guesses[fine_only ? 0 : attempt - 1];
+    const Eigen::Isometry3d fine_start =
+        fine_only ? start
+                  : coarse_solver
+                        .align(*current.edges, *current.planes, submap.coarse(), start,
+                               config.coarse_rounds)
+                        .T_world_lidar;
     const RegistrationResult r = fine_solver.align(*current.edges, *current.planes, submap.fine(),
-                                                   rough.T_world_lidar, config.rounds);
+                                                   fine_start, config.rounds);
     LoopMatch match;
     match.T_loop_current = T_anchor_loop.inverse() * r.T_world_lidar;
     match.inlier_fraction = static_cast<double>(r.edge_matches + r.plane_matches) / features;

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -39,7 +40,9 @@ std::vector<Eigen::Isometry3d> loop_initial_guesses(const Eigen::Isometry3d& T_w
 
 // The feature maps of a submap (coarse and fine), in the frame of its anchor keyframe. Building
 // it costs more than registering to it (about 127 vs 38 ms for 51 keyframes), and consecutive
-// loop frames revisit neighbouring keyframes, so the loop stage keeps one and reuses it.
+// loop frames revisit neighbouring keyframes, so the loop stage keeps one and reuses it. The
+// coarse map is built on first use only (fine_first: a loop whose guess is already good never
+// needs it); one thread at a time.
 class LoopSubmap {
  public:
   // `keyframes` are keyframes first_keyframe, first_keyframe + 1, ...; `anchor` indexes them.
@@ -49,12 +52,16 @@ class LoopSubmap {
   std::size_t first_keyframe() const { return first_; }
   std::size_t last_keyframe() const { return last_; }
   std::size_t anchor_keyframe() const { return anchor_; }
-  const FeatureMap& coarse() const { return coarse_; }
+  const FeatureMap& coarse() const;
   const FeatureMap& fine() const { return fine_; }
 
  private:
   std::size_t first_, last_, anchor_;
-  FeatureMap coarse_, fine_;
+  RegistrationConfig coarse_registration_;
+  LocalMapConfig coarse_map_;
+  FeatureCloud edges_anchor_, planes_anchor_;  // every keyframe's features, anchor frame
+  mutable std::optional<FeatureMap> coarse_;
+  FeatureMap fine_;
 };
 
 // The paper's method on a prepared submap: `T_world_anchor` and `T_world_loop` are the current

@@ -14,6 +14,10 @@ struct LoopRegistrationConfig {
   double coarse_radius_m = 2.5;
   int coarse_rounds = 6;
   int rounds = 6;
+  // Try the fine stage alone from the pose guess first: once a revisit's first loop has closed
+  // the graph, the poses are right to centimetres and the coarse stage only costs time.
+  // Falls back to coarse to fine (both guesses) when that match fails the check.
+  bool fine_first = true;
   // A match is accepted when at least this fraction of the current features found a line or
   // plane in the submap and their mean distance is below max_mean_residual_m.
   double min_inlier_fraction = 0.45;
