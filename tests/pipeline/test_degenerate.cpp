@@ -96,10 +96,7 @@ double worst_step_error_m(const PoseList& est, const PoseList& gt, std::size_t a
 
 // A straight tunnel: inside, scan matching cannot see motion along the axis. The odometry must
 // flag it, stay finite, and after the exit track the motion again frame by frame.
-// DISABLED: fails today and is kept as the acceptance test of issue 8's open part (the
-// odometry does not yet flag this scene's weak direction: its eigenvalue test is absolute and
-// many low-information matches pass it). Run with --gtest_also_run_disabled_tests.
-TEST(Degenerate, DISABLED_TunnelIsFlaggedAndTheOdometryRecoversAfterTheExit) {
+TEST(Degenerate, TunnelIsFlaggedAndTheOdometryRecoversAfterTheExit) {
   const Scene scene = simulated("tunnel", 300, false);
   const auto source = open_scan_source(scene.dir);
   const PoseList gt = source->ground_truth_lidar();
