@@ -4,7 +4,11 @@
 //   OUT/memory.csv   elapsed_s, frames_read, rss_mb           (every --sample-s seconds)
 //   OUT/frames.csv   frame, features_ms, registration_ms       (every frame)
 //   OUT/summary.json the run's summary.json plus what is stored per keyframe
+//   OUT/loops.csv    current_frame, loop_frame, verdict        (registered loop candidates)
+// Both CSVs are rewritten every 60 s while the run goes on, so a stopped run leaves its data.
 // Usage: long_run LAP_DIR OUT_DIR [--frames 20000] [--mode optimized] [--sample-s 2]
+//                 [--resident-keyframes N] [--rebuild-cell-m M]  (pipeline.* keys)
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -75,18 +79,23 @@ double current_rss_mb() {
 
 int main(int argc, char** argv) try {
   if (argc < 3) {
-    std::fprintf(stderr, "usage: long_run LAP_DIR OUT_DIR [--frames 20000] [--mode optimized] [--sample-s 2]\n");
+    std::fprintf(stderr,
+                 "usage: long_run LAP_DIR OUT_DIR [--frames 20000] [--mode optimized] [--sample-s 2]"
+                 " [--resident-keyframes N] [--rebuild-cell-m M]\n");
     return 2;
   }
   const fs::path lap_dir = argv[1], out_dir = argv[2];
   std::size_t frames = 20000;
   std::string mode_text = "optimized";
   double sample_s = 2;
+  SlamConfig config;
   for (int i = 3; i + 1 < argc; i += 2) {
     const std::string key = argv[i], value = argv[i + 1];
     if (key == "--frames") frames = std::stoul(value);
     else if (key == "--mode") mode_text = value;
     else if (key == "--sample-s") sample_s = std::stod(value);
+    else if (key == "--resident-keyframes") config.pipeline.resident_keyframes = std::stoi(value);
+    else if (key == "--rebuild-cell-m") config.pipeline.map_rebuild_cell_m = std::stod(value);
     else throw Error("unknown option " + key);
   }
   const auto mode = parse_mode(mode_text);
@@ -94,64 +103,94 @@ int main(int argc, char** argv) try {
   fs::create_directories(out_dir);
   RepeatingSource source(open_scan_source(lap_dir), frames);
 
-  // Memory sampler: resident set size against frames read, while the pipeline runs.
+  // Memory sampler: resident set size against frames read, while the pipeline runs; the
+  // odometry's per-frame times arrive through on_frame.
   std::ostringstream memory_csv;
   memory_csv << "elapsed_s,frames_read,rss_mb\n";
+  std::vector<std::array<double, 2>> frame_ms;
+  frame_ms.reserve(frames);
   std::mutex m;
   std::condition_variable cv;
   bool done = false;
+  const auto write_csvs = [&] {  // m held
+    write_file_atomic(out_dir / "memory.csv", memory_csv.str());
+    write_file_atomic(out_dir / "frames.csv", [&](std::ostream& out) {
+      out << "frame,features_ms,registration_ms\n";
+      char row[64];
+      for (std::size_t i = 0; i < frame_ms.size(); ++i) {
+        std::snprintf(row, sizeof row, "%zu,%.3f,%.3f\n", i, frame_ms[i][0], frame_ms[i][1]);
+        out << row;
+      }
+    });
+  };
   const auto start = std::chrono::steady_clock::now();
   std::thread sampler([&] {
     std::unique_lock<std::mutex> lock(m);
+    double last_write_s = 0;
     do {
       const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       char row[96];
       std::snprintf(row, sizeof row, "%.1f,%zu,%.1f\n", t, source.frames_read(), current_rss_mb());
       memory_csv << row;
+      if (t - last_write_s > 60) {
+        write_csvs();
+        last_write_s = t;
+      }
     } while (!cv.wait_for(lock, std::chrono::duration<double>(sample_s), [&] { return done; }));
   });
 
   RunOptions options;
   options.mode = *mode;
   options.progress = true;
-  RunResult result = run_slam(source, SlamConfig{}, options);
-  {
+  options.on_frame = [&](std::size_t, double features_ms, double registration_ms) {
     std::lock_guard<std::mutex> lock(m);
-    done = true;
-  }
-  cv.notify_one();
-  sampler.join();
-
-  write_file_atomic(out_dir / "memory.csv", memory_csv.str());
-  write_file_atomic(out_dir / "frames.csv", [&](std::ostream& out) {
-    out << "frame,features_ms,registration_ms\n";
-    const auto& f = result.timing_ms["features"];
-    const auto& r = result.timing_ms["registration"];
-    char row[64];
-    for (std::size_t i = 0; i < f.size() && i < r.size(); ++i) {
-      std::snprintf(row, sizeof row, "%zu,%.3f,%.3f\n", i, f[i], r[i]);
-      out << row;
+    frame_ms.push_back({features_ms, registration_ms});
+  };
+  const auto stop_sampler = [&] {
+    {
+      std::lock_guard<std::mutex> lock(m);
+      done = true;
+      write_csvs();
     }
-  });
-  // What every keyframe keeps for the rest of the run.
-  std::size_t edge_points = 0, plane_points = 0, raw_points = 0;
-  for (const auto& kf : result.keyframes) {
-    edge_points += kf->edges.size();
-    plane_points += kf->planes.size();
-    raw_points += kf->raw.size();
+    cv.notify_one();
+    sampler.join();
+  };
+  RunResult result;
+  try {
+    result = run_slam(source, config, options);
+  } catch (...) {
+    stop_sampler();  // what was measured so far stays on disk
+    throw;
   }
-  const double kfs = std::max<std::size_t>(1, result.keyframes.size());
+  stop_sampler();
+
+  // Loops over time: every candidate that passed score and gate, with its final verdict.
+  write_file_atomic(out_dir / "loops.csv", [&](std::ostream& out) {
+    out << "current_frame,loop_frame,verdict\n";
+    for (const auto& row : result.loop_rows)
+      if (row.verdict == LoopVerdict::kAccepted || row.verdict == LoopVerdict::kRejectedMatch)
+        out << row.current_frame << ',' << row.loop_frame << ',' << to_string(row.verdict) << '\n';
+  });
+  // What every keyframe keeps for the rest of the run, and where.
+  const KeyframeStorageStats& s = result.keyframe_storage;
+  const double kfs = std::max<std::size_t>(1, s.keyframes);
   nlohmann::json summary = make_summary(source, result);
   summary["keyframe_storage"] = {
-      {"keyframes", result.keyframes.size()},
-      {"edge_points_per_keyframe", edge_points / kfs},
-      {"plane_points_per_keyframe", plane_points / kfs},
-      {"raw_points_per_keyframe", raw_points / kfs},
-      {"feature_bytes_per_keyframe", (edge_points + plane_points + raw_points) * sizeof(Eigen::Vector3f) / kfs},
+      {"keyframes", s.keyframes},
+      {"resident", s.resident},
+      {"resident_limit", s.resident_limit},
+      {"spilled", s.spilled},
+      {"spill_mb", s.spill_bytes / 1e6},
+      {"reloads", s.reloads},
+      {"edge_points_per_keyframe", s.edge_points / kfs},
+      {"plane_points_per_keyframe", s.plane_points / kfs},
+      {"raw_points_per_keyframe", s.raw_points / kfs},
+      {"feature_bytes_per_keyframe",
+       (s.edge_points + s.plane_points + s.raw_points) * sizeof(Eigen::Vector3f) / kfs},
       {"graph_nodes", result.graph ? result.graph->size() : 0}};
   write_file_atomic(out_dir / "summary.json", summary.dump(2) + "\n");
-  std::printf("%zu frames, %zu keyframes, peak RSS %.0f MB, %.1f s\n", result.T_world_lidar.size(),
-              result.keyframes.size(), peak_rss_mb(), result.wall_s);
+  std::printf("%zu frames, %zu keyframes (%zu resident), peak RSS %.0f MB, %.1f s\n",
+              result.T_world_lidar.size(), s.keyframes, s.resident, peak_rss_mb(), result.wall_s);
   return 0;
 } catch (const std::exception& e) {
   std::fprintf(stderr, "error: %s\n", e.what());

@@ -14,7 +14,10 @@ import matplotlib.pyplot as plt
 out_dir, png, table_path = sys.argv[1:4]
 mem = list(csv.DictReader(open(f"{out_dir}/memory.csv")))
 frames = list(csv.DictReader(open(f"{out_dir}/frames.csv")))
-summary = json.load(open(f"{out_dir}/summary.json"))
+try:
+    summary = json.load(open(f"{out_dir}/summary.json"))
+except FileNotFoundError:  # a run still going on or stopped: its CSVs so far
+    summary = {"mode": "unfinished run"}
 ms = [float(r["features_ms"]) + float(r["registration_ms"]) for r in frames]
 n = len(ms)
 block = 2000 if n >= 4000 else max(1, n // 10)
@@ -42,6 +45,17 @@ fig.tight_layout()
 fig.savefig(png, dpi=110)
 
 
+loops = []
+try:
+    loops = list(csv.DictReader(open(f"{out_dir}/loops.csv")))
+except FileNotFoundError:
+    pass
+
+
+def loops_in(a, b):
+    return sum(1 for r in loops if a <= int(r["current_frame"]) < b and r["verdict"] == "accepted")
+
+
 def rss_at(frame):
     best = None
     for r in mem:
@@ -50,10 +64,11 @@ def rss_at(frame):
     return best if best is not None else float("nan")
 
 
-rows = ["| frames | RSS at end (MB) | median ms/frame | p95 ms/frame |", "| --- | --- | --- | --- |"]
+rows = ["| frames | RSS at end (MB) | median ms/frame | p95 ms/frame | loops accepted |",
+        "| --- | --- | --- | --- | --- |"]
 for a in range(0, n, block):
     chunk = sorted(ms[a:a + block])
     rows.append(f"| {a}-{a + len(chunk) - 1} | {rss_at(a + len(chunk)):.0f} | {statistics.median(chunk):.2f} | "
-                f"{chunk[min(len(chunk) - 1, int(0.95 * len(chunk)))]:.2f} |")
+                f"{chunk[min(len(chunk) - 1, int(0.95 * len(chunk)))]:.2f} | {loops_in(a, a + len(chunk))} |")
 open(table_path, "w").write("\n".join(rows) + "\n")
 print("\n".join(rows))

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <exception>
 #include <thread>
+#include <unordered_set>
 #include <utility>
 
 #include "pipeline/keyframe_store.hpp"
@@ -118,7 +119,8 @@ class DetectionStage {
 // Loop detection and loop closure on their own threads, fed keyframe by keyframe.
 class LoopThreads {
  public:
-  LoopThreads(DetectionStage& detection, LoopClosure& closure, int capacity)
+  LoopThreads(DetectionStage& detection, LoopClosure& closure, const KeyframeStore& store,
+              int capacity)
       : to_detection_(capacity), to_closure_(capacity) {
     detection_thread_ = std::thread([this, &detection] {
       guarded([&] {
@@ -127,9 +129,12 @@ class LoopThreads {
       });
       to_closure_.close();
     });
-    closure_thread_ = std::thread([this, &closure] {
+    closure_thread_ = std::thread([this, &closure, &store] {
       guarded([&] {
-        while (auto item = to_closure_.pop()) closure.add(item->keyframe, item->query);
+        while (auto item = to_closure_.pop()) {
+          const KeyframeStore::Hold hold(store);  // its submap views point into clouds
+          closure.add(item->keyframe, item->query);
+        }
       });
     });
   }
@@ -238,14 +243,30 @@ class OdometryStage {
     std::vector<std::pair<Eigen::Isometry3d, const FeatureCloud*>> edges, planes;
     std::vector<KeyframePtr> keep;
     const double radius = config_.odometry.map.radius_m;
-    for (std::size_t i = 0; i < corrected.size(); ++i) {
-      if ((corrected[i].translation() - T_world_now.translation()).norm() > radius) continue;
+    const double cell_m = config_.pipeline.map_rebuild_cell_m;
+    std::unordered_set<std::uint64_t> taken;  // cells that already have a newer keyframe
+    for (std::size_t i = corrected.size(); i-- > 0;) {
+      const Eigen::Vector3d p = corrected[i].translation();
+      if ((p - T_world_now.translation()).norm() > radius) continue;
+      // On a revisit the newest keyframe of a place stands for the older ones: the rebuild
+      // (and the memory it reads back) is bounded by the area, not by the laps driven.
+      if (cell_m > 0 && !taken.insert(cell_key(p, cell_m)).second) continue;
       keep.push_back(store_.get(i));
       edges.emplace_back(corrected[i], &keep.back()->edges);
       planes.emplace_back(corrected[i], &keep.back()->planes);
     }
+    // Inserted oldest first, as the odometry itself built the map.
+    std::reverse(edges.begin(), edges.end());
+    std::reverse(planes.begin(), planes.end());
     odometry_.reset_map(edges, planes, T_world_now);
     last_rebuild_position_ = T_world_now.translation();
+  }
+
+  static std::uint64_t cell_key(const Eigen::Vector3d& p, double cell_m) {
+    const auto c = [&](double v) {
+      return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(v / cell_m)) & 0x1FFFFF);
+    };
+    return (c(p.x()) << 42) | (c(p.y()) << 21) | c(p.z());
   }
 
   // Rebuilding costs hundreds of milliseconds (every keyframe within the map radius). The
@@ -300,7 +321,8 @@ RunResult run_slam(const ScanSource& source, const SlamConfig& base_config,
   RunResult result;
   result.mode = options.mode;
   Stopwatch wall;
-  KeyframeStore store;
+  KeyframeStore store(static_cast<std::size_t>(config.pipeline.resident_keyframes),
+                      config.pipeline.spill_dir);
   OdometryStage odometry(config, store, loops);
   DetectionStage detection(config.loop_detection, store);
   LoopClosure closure(config,
@@ -308,7 +330,7 @@ RunResult run_slam(const ScanSource& source, const SlamConfig& base_config,
                                                           : LoopRegistrationMethod::kFeatures,
                       store);
   std::optional<LoopThreads> threads;
-  if (loops && !deterministic) threads.emplace(detection, closure, config.pipeline.queue_capacity);
+  if (loops && !deterministic) threads.emplace(detection, closure, store, config.pipeline.queue_capacity);
 
   ScanPrefetcher prefetcher(source, count);
   ProgressBar progress(mode_name(options.mode), count, options.progress);
@@ -326,11 +348,14 @@ RunResult run_slam(const ScanSource& source, const SlamConfig& base_config,
         threads->push(std::move(kf));
         wait_queue_ms.push_back(queue_watch.elapsed_ms());
       } else {
-        closure.add(kf, detection.detect(kf));
+        const LoopQuery query = detection.detect(kf);
+        const KeyframeStore::Hold hold(store);
+        closure.add(kf, query);
       }
     }
     const auto& f = result.timing_ms["features"];
     const auto& r = result.timing_ms["registration"];
+    if (options.on_frame) options.on_frame(index, f.back(), r.back());
     char note[64];
     std::snprintf(note, sizeof note, "%.1f ms/frame, %zu loops", f.back() + r.back(),
                   closure.accepted_loops());
@@ -347,7 +372,7 @@ RunResult run_slam(const ScanSource& source, const SlamConfig& base_config,
 
   result.keyframe_poses = store.current_poses();
   result.T_world_lidar = odometry.final_poses(result.keyframe_poses);
-  for (std::size_t i = 0; i < store.size(); ++i) result.keyframes.push_back(store.get(i));
+  result.keyframe_storage = store.stats();
   if (loops) {
     result.timing_ms["loop_detection"] = detection.ms();
     result.timing_ms["loop_registration"] = closure.registration_ms();

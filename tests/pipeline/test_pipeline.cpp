@@ -33,12 +33,12 @@ fs::path loops_sequence() {
   return dir;
 }
 
-RunResult run(const ScanSource& source, SlamMode mode) {
+RunResult run(const ScanSource& source, SlamMode mode, const SlamConfig& config = {}) {
   RunOptions options;
   options.mode = mode;
   options.progress = false;
   options.deterministic = true;
-  return run_slam(source, SlamConfig{}, options);
+  return run_slam(source, config, options);
 }
 
 EvalReport accuracy(const ScanSource& source, const PoseList& est) {
@@ -49,16 +49,26 @@ EvalReport accuracy(const ScanSource& source, const PoseList& est) {
 
 }  // namespace
 
+// The second run also keeps only 8 keyframes' clouds in memory and reads the others back from
+// the spill file: spilling is exact, so the result is identical.
 TEST(Pipeline, OptimizedModeClosesTrueLoopsAndIsDeterministic) {
   const auto source = open_scan_source(loops_sequence());
   const PoseList gt = source->ground_truth_lidar();
   const RunResult first = run(*source, SlamMode::kOptimized);
-  const RunResult second = run(*source, SlamMode::kOptimized);
+  SlamConfig spilling;
+  spilling.pipeline.resident_keyframes = 8;
+  const RunResult second = run(*source, SlamMode::kOptimized, spilling);
 
   ASSERT_EQ(first.T_world_lidar.size(), source->size());
   ASSERT_EQ(second.T_world_lidar.size(), source->size());
   for (std::size_t i = 0; i < first.T_world_lidar.size(); ++i)
     ASSERT_TRUE(first.T_world_lidar[i].matrix() == second.T_world_lidar[i].matrix()) << "frame " << i;
+  ASSERT_EQ(first.loop_rows.size(), second.loop_rows.size());
+  EXPECT_EQ(first.keyframe_storage.spilled, 0u);
+  EXPECT_EQ(second.keyframe_storage.keyframes, first.keyframe_storage.keyframes);
+  EXPECT_LE(second.keyframe_storage.resident, 8u);
+  EXPECT_GT(second.keyframe_storage.spilled, second.keyframe_storage.keyframes / 2);
+  EXPECT_GT(second.keyframe_storage.reloads, 0u);  // loop submaps and map rebuilds read them back
 
   // Every accepted loop joins frames that are truly close (no false loop), and there are some.
   std::size_t accepted = 0;

@@ -3,6 +3,7 @@
 
 #include <atomic>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -34,6 +35,20 @@ struct RunOptions {
   // Set from elsewhere (a signal handler) to stop early: checked between frames; the loop work
   // already queued is finished, so the result is a complete run over the frames processed.
   const std::atomic<bool>* stop = nullptr;
+  // Called on the odometry's thread after every frame (frame, features_ms, registration_ms):
+  // lets a long run record its timings while it goes on.
+  std::function<void(std::size_t, double, double)> on_frame;
+};
+
+// Where the keyframes' clouds are at the end of a run (pipeline.resident_keyframes).
+struct KeyframeStorageStats {
+  std::size_t keyframes = 0;
+  std::size_t resident = 0;        // clouds in memory
+  std::size_t resident_limit = 0;  // 0: no limit
+  std::size_t spilled = 0;         // clouds written to the spill file
+  std::size_t spill_bytes = 0;
+  std::size_t reloads = 0;         // clouds read back from it
+  std::size_t edge_points = 0, plane_points = 0, raw_points = 0;  // over all keyframes
 };
 
 class PoseGraph;
@@ -49,12 +64,11 @@ struct RunResult {
   std::map<std::string, std::vector<double>> timing_ms;
   double wall_s = 0;
   bool interrupted = false;  // RunOptions::stop ended the run before the last scan
-  // Loop modes only: every loop candidate with its verdict, the final graph, the keyframes
-  // with their final poses.
+  // Loop modes only: every loop candidate with its verdict, the final graph.
   std::vector<LoopCandidate> loop_rows;
   std::shared_ptr<const PoseGraph> graph;
-  std::vector<KeyframePtr> keyframes;
-  PoseList keyframe_poses;
+  PoseList keyframe_poses;  // final pose of every keyframe
+  KeyframeStorageStats keyframe_storage;
 };
 
 RunResult run_slam(const ScanSource& source, const SlamConfig& config, const RunOptions& options);
