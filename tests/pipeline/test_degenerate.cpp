@@ -163,9 +163,7 @@ TEST(Degenerate, StationaryCarDoesNotDrift) {
 
 // 1 s of data missing: the stamps jump from k to k + 1.1 s while the car moves ~8 m. The
 // prediction must use the real time step so that the first frame after the gap is matched.
-// DISABLED: fails today (step error over the gap 1.6 m after the prediction learned to scale
-// with the real interval; 5.6 m before), kept as the acceptance test of issue 8's open part.
-TEST(Degenerate, DISABLED_GapOfOneSecondIsBridged) {
+TEST(Degenerate, GapOfOneSecondIsBridged) {
   const Scene scene = simulated("gap", 200, true);
   const auto source = open_scan_source(scene.dir);
   const PoseList gt = source->ground_truth_lidar();
