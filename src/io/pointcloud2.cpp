@@ -116,6 +116,9 @@ TimeRule choose_time_rule(const PointCloud2View& cloud, const PointField& ft, bo
   return {};
 }
 
+// False for NaN, infinities and doubles out of float range.
+bool fits_float(double v) { return std::abs(v) <= std::numeric_limits<float>::max(); }
+
 }  // namespace
 
 std::size_t point_field_size(std::uint8_t datatype) {
@@ -197,7 +200,8 @@ Scan pointcloud2_to_scan(const PointCloud2View& cloud, const std::string& where)
       const double x = read_value(p + fx->offset, fx->datatype, swap);
       const double y = read_value(p + fy->offset, fy->datatype, swap);
       const double z = read_value(p + fz->offset, fz->datatype, swap);
-      if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) continue;
+      // Finite as floats too: a FLOAT64 coordinate beyond 3.4e38 would become inf.
+      if (!fits_float(x) || !fits_float(y) || !fits_float(z)) continue;
       LidarPoint pt;
       pt.x = static_cast<float>(x);
       pt.y = static_cast<float>(y);
