@@ -82,9 +82,9 @@ struct RegistrationConfig {
   // KITTI-05-like >= 0.27 and >= 0.15; inside the tunnel 0.17-0.2 and 0.017-0.05.
   double degeneracy_min_translation_ratio = 0.2;
   double degeneracy_min_rotation_ratio = 0.05;
-  // Odometry: when the prediction is a guess (the second frame, from zero velocity; the frame
-  // after a gap) a coarse pass first aligns the scan to the previous frame's features with
-  // this search radius, wider than max_neighbor_dist_m's basin (0 = no coarse pass).
+  // Odometry: the second frame's prediction is a guess (zero velocity), so a coarse pass first
+  // aligns it to the first frame's features with this search radius, wider than
+  // max_neighbor_dist_m's basin (0 = no coarse pass). Gaps are handled apart (odometry.cpp).
   double coarse_neighbor_dist_m = 3.0;
   int num_threads = 2;               // TBB correspondence search and Ceres evaluation
 };

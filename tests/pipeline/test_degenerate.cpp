@@ -121,9 +121,11 @@ TEST(Degenerate, TunnelIsFlaggedAndTheOdometryRecoversAfterTheExit) {
 }
 
 // Flat open ground with a few far objects: poorly constrained in x, y and yaw.
-// DISABLED: fails today and is kept as the acceptance test of issue 8's open part (the
-// odometry does not yet flag this scene's weak direction: its eigenvalue test is absolute and
-// many low-information matches pass it). Run with --gtest_also_run_disabled_tests.
+// DISABLED: fails (measured 2026-11-22: 199 of 200 frames flagged, end error 218.6 m over
+// 204 m). The flag works, but the estimate stalls from frame 1 (0.9 m short): ring-pattern
+// edges on the smooth ground pull the pose back to "no motion", and the fallback keeps a
+// velocity that was never measured (docs/degenerate.md). Run with
+// --gtest_also_run_disabled_tests.
 TEST(Degenerate, DISABLED_OpenFieldStaysFiniteAndBounded) {
   const Scene scene = simulated("open-field", 200, false);
   const auto source = open_scan_source(scene.dir);
@@ -181,9 +183,11 @@ TEST(Degenerate, GapOfOneSecondIsBridged) {
 }
 
 // Every other beam, then the upper half of the beams, missing for a quarter of the drive each.
-// DISABLED: fails today and is kept as the acceptance test of issue 8's open part (the
-// odometry does not yet flag this scene's weak direction: its eigenvalue test is absolute and
-// many low-information matches pass it). Run with --gtest_also_run_disabled_tests.
+// DISABLED: fails (measured 2026-11-22: the odd-ring quarter is fine at 0.009 m per step,
+// but with the upper half gone the lower rings see only the ground within ~12 m, the
+// estimate slows down, and the worst step error is 0.51 m, 0.50 m on the first full frame).
+// The 10 cm bound does not hold for the upper-half loss (docs/degenerate.md). Run with
+// --gtest_also_run_disabled_tests.
 TEST(Degenerate, DISABLED_HalfTheBeamsMissingKeepsTracking) {
   const Scene scene = simulated("half-beams", 200, true);
   const auto source = open_scan_source(scene.dir);
