@@ -11,8 +11,9 @@ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSCFLOAM_TSAN=ON \
   -DSCFLOAM_BUILD_BENCH=OFF -DSCFLOAM_SHARED_DIR="$shared" >"$build.configure.log" 2>&1 ||
   { cat "$build.configure.log"; exit 1; }
 cmake --build "$build" -j"$(nproc)" --target test_core test_loop test_pipeline
-# halt_on_error: the first race fails the test; second_deadlock_stack: both lock orders shown.
-export TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 history_size=4 ${TSAN_OPTIONS:-}"
+# halt_on_error: the first race fails the test; second_deadlock_stack: both lock orders shown;
+# tsan.supp: TBB's own task hand-off (libtbb is not instrumented), see that file.
+export TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 history_size=4 suppressions=$PWD/scripts/tsan.supp ${TSAN_OPTIONS:-}"
 "$build/bin/test_core" --gtest_filter='BoundedQueue.*'
 "$build/bin/test_loop" --gtest_filter='RingKeyIndex.*'
 "$build/bin/test_pipeline"
