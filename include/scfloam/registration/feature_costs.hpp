@@ -104,7 +104,12 @@ class NormalEquationCost : public ceres::CostFunction {
   const std::vector<PlaneMatch>& planes_;
   double delta_;
   tbb::task_arena* arena_;
-  mutable std::vector<Sums> blocks_;  // per-block partial sums (scratch)
+  std::vector<Eigen::Matrix<double, 2, 3>> edge_bases_;  // perpendicular_basis of each line
+  // Per-block partial sums: upper triangle of J^T J (21), J^T r (6), |r|^2.
+  struct Partial {
+    double H[21], g[6], squared_norm;
+  };
+  mutable std::vector<Partial> blocks_;
 };
 
 }  // namespace scfloam
