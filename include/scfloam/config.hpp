@@ -65,6 +65,12 @@ struct RegistrationConfig {
   // Stop the rounds early once one moves the pose less than both of these.
   double converged_translation_m = 0.001;
   double converged_rotation_deg = 0.01;
+  // Rounds past the frame's count while the last one still moved the pose more than either of
+  // these (a jolt or a turn harder than the constant-velocity model): at most
+  // outer_iterations_max rounds in all (<= the frame's count = never more).
+  int outer_iterations_max = 12;
+  double unconverged_translation_m = 0.01;
+  double unconverged_rotation_deg = 0.05;
   // Inside a round, Ceres stops once an accepted step's tangent norm |[omega; v]| (rad, m) is
   // below this (0 = always run inner_iterations).
   double solver_step_tolerance = 1e-4;

@@ -56,6 +56,9 @@ std::vector<Binding> bindings(SlamConfig& c) {
       {reg, "match_refresh_m", &o.registration.match_refresh_m},
       {reg, "converged_translation_m", &o.registration.converged_translation_m},
       {reg, "converged_rotation_deg", &o.registration.converged_rotation_deg},
+      {reg, "outer_iterations_max", &o.registration.outer_iterations_max},
+      {reg, "unconverged_translation_m", &o.registration.unconverged_translation_m},
+      {reg, "unconverged_rotation_deg", &o.registration.unconverged_rotation_deg},
       {reg, "solver_step_tolerance", &o.registration.solver_step_tolerance},
       {reg, "degeneracy_min_eigenvalue", &o.registration.degeneracy_min_eigenvalue},
       {reg, "degeneracy_min_rotation_eigenvalue",
@@ -198,6 +201,11 @@ void check_ranges(const SlamConfig& c, const std::filesystem::path& path) {
   require(o.registration.max_neighbor_dist_m > 0, "odometry.registration.max_neighbor_dist_m", "> 0");
   require(o.registration.inner_iterations >= 1, "odometry.registration.inner_iterations", ">= 1");
   require(o.registration.outer_iterations >= 1, "odometry.registration.outer_iterations", ">= 1");
+  require(o.registration.outer_iterations_max >= 0, "odometry.registration.outer_iterations_max", ">= 0");
+  require(o.registration.unconverged_translation_m >= 0,
+          "odometry.registration.unconverged_translation_m", ">= 0");
+  require(o.registration.unconverged_rotation_deg >= 0,
+          "odometry.registration.unconverged_rotation_deg", ">= 0");
   require(o.registration.num_threads >= 1, "odometry.registration.num_threads", ">= 1");
   require(o.map.edge_spacing_m >= 0, "odometry.map.edge_spacing_m", ">= 0");
   require(o.map.plane_spacing_m >= 0, "odometry.map.plane_spacing_m", ">= 0");

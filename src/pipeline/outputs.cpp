@@ -133,6 +133,12 @@ nlohmann::json make_summary(const ScanSource& source, const RunResult& result) {
   summary["frames"] = result.T_world_lidar.size();
   summary["keyframes"] = result.keyframe_frames.size();
   summary["degenerate_frames"] = result.degenerate_frames;
+  // Frames per number of correspondence rounds: {"2": frames, ...}; extra rounds past the
+  // steady-state count show where the motion model was off.
+  nlohmann::json rounds = nlohmann::json::object();
+  for (std::size_t k = 0; k < result.registration_rounds.size(); ++k)
+    if (result.registration_rounds[k]) rounds[std::to_string(k)] = result.registration_rounds[k];
+  summary["registration_rounds"] = rounds;
   summary["wall_s"] = result.wall_s;
   summary["fps"] = result.wall_s > 0 ? result.T_world_lidar.size() / result.wall_s : 0.0;
   summary["peak_rss_mb"] = peak_rss_mb();

@@ -199,6 +199,9 @@ class OdometryStage {
     result.timing_ms["features"].push_back(odom.features_ms);
     result.timing_ms["registration"].push_back(odom.registration_ms);
     if (odom.degenerate) ++result.degenerate_frames;
+    const auto rounds = static_cast<std::size_t>(std::max(0, odom.registration_rounds));
+    if (result.registration_rounds.size() <= rounds) result.registration_rounds.resize(rounds + 1, 0);
+    ++result.registration_rounds[rounds];
 
     KeyframePtr made;
     if (selector_.update(T_chain_)) {

@@ -234,7 +234,8 @@ RegistrationResult ScanToMapRegistration::align(const FeatureCloud& edges_lidar,
   edge_out_.clear();
   plane_out_.clear();
 
-  for (int round = 0; round < rounds; ++round) {
+  const int max_rounds = std::max(rounds, config_.outer_iterations_max);
+  for (int round = 0; round < max_rounds; ++round) {
     find_matches(edges_lidar, planes_lidar, map, block_to_pose(pose), round == 0);
     if (edge_out_.size() + plane_out_.size() < kMinMatches) break;
     // Degenerate directions of this round's matches: the solver may not move along them
@@ -275,8 +276,13 @@ RegistrationResult ScanToMapRegistration::align(const FeatureCloud& edges_lidar,
     }
     ++result.rounds;
     const Eigen::Isometry3d step = T_before.inverse() * block_to_pose(pose);
-    if (step.translation().norm() < config_.converged_translation_m &&
-        rotation_angle_rad(step.linear()) * 180.0 / M_PI < config_.converged_rotation_deg)
+    const double step_m = step.translation().norm();
+    const double step_deg = rotation_angle_rad(step.linear()) * 180.0 / M_PI;
+    if (step_m < config_.converged_translation_m && step_deg < config_.converged_rotation_deg)
+      break;
+    // The frame's rounds are spent: go on only while the pose is still moving.
+    if (round + 1 >= rounds && step_m < config_.unconverged_translation_m &&
+        step_deg < config_.unconverged_rotation_deg)
       break;
   }
 

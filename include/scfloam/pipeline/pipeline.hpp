@@ -60,6 +60,8 @@ struct RunResult {
   PoseList odometry_T_world_lidar;   // every frame, as the odometry estimated it
   std::vector<std::size_t> keyframe_frames;
   std::size_t degenerate_frames = 0;
+  // How many frames ran each number of correspondence rounds (index = rounds).
+  std::vector<std::size_t> registration_rounds;
   // Per-stage samples in milliseconds ("features", "registration", ...).
   std::map<std::string, std::vector<double>> timing_ms;
   double wall_s = 0;
