@@ -43,6 +43,15 @@ TEST(CliRun, OdometryOnRealKittiScansWritesEveryOutput) {
     for (const char* stat : {"median", "mean", "p95", "count"})
       EXPECT_TRUE(summary["timing_ms"][stage].contains(stat)) << stage << "." << stat;
   EXPECT_EQ(summary["timing_ms"]["features"]["count"], 10);
+  // Frames per correspondence-round count: every frame once; the first frame matches nothing
+  // (0 rounds), the next start from F-LOAM's 12 initial rounds and may converge sooner.
+  ASSERT_TRUE(summary.contains("registration_rounds"));
+  int counted = 0;
+  for (const auto& [rounds, frames] : summary["registration_rounds"].items()) {
+    EXPECT_LE(std::stoi(rounds), 12) << rounds;
+    counted += frames.get<int>();
+  }
+  EXPECT_EQ(counted, 10);
   EXPECT_TRUE(summary.contains("accuracy"));  // poses.txt is there: ATE against it
   // The car moves about 5 m forward over these frames (ground truth).
   EXPECT_GT(scfloam::read_kitti_poses(out / "poses_kitti.txt").back().translation().z(), 4.0);
