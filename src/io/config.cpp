@@ -122,6 +122,7 @@ std::vector<Binding> bindings(SlamConfig& c) {
       {pg, "loop_cauchy_scale", &g.loop_cauchy_scale},
       {pg, "loop_outlier_chi2", &g.loop_outlier_chi2},
       {pg, "max_outlier_rounds", &g.max_outlier_rounds},
+      {pg, "skip_solve_loop_chi2", &g.skip_solve_loop_chi2},
       {pg, "max_iterations", &g.max_iterations},
   });
   auto& p = c.pipeline;

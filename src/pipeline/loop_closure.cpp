@@ -95,11 +95,28 @@ bool LoopClosure::add(const KeyframePtr& keyframe, const LoopQuery& detected) {
   // Edge from the current keyframe to the loop keyframe.
   graph_.add_loop_edge(k, loop_kf, match.T_loop_current.inverse(), config_.pose_graph);
   loop_rows_.push_back(*row);
+  if (graph_.edge_chi2(graph_.edges().size() - 1) < config_.pose_graph.skip_solve_loop_chi2) {
+    // Already consistent: the edge joins the graph for the next solve; the poses stand.
+    ++solves_skipped_;
+    unsolved_loops_ = true;
+    accepted_ = graph_.loop_edge_count();
+    return true;
+  }
   watch.restart();
   const PoseGraphReport report = graph_.optimize(config_.pose_graph);
   optimization_ms_.push_back(watch.elapsed_ms());
+  unsolved_loops_ = false;
   publish(report);
   return true;
+}
+
+void LoopClosure::finish() {
+  if (!unsolved_loops_) return;
+  Stopwatch watch;
+  const PoseGraphReport report = graph_.optimize(config_.pose_graph);
+  optimization_ms_.push_back(watch.elapsed_ms());
+  unsolved_loops_ = false;
+  publish(report);
 }
 
 void LoopClosure::publish(const PoseGraphReport& report) {

@@ -26,12 +26,17 @@ class LoopClosure {
   // Adds keyframe `keyframe` (already in the store) and handles the loop its query proposed.
   // Returns true when the graph was re-optimized (the store then holds corrected poses).
   bool add(const KeyframePtr& keyframe, const LoopQuery& query);
+  // End of the run: one solve if loops were added without one since the last (their edges
+  // then inform the final poses).
+  void finish();
 
   const LoopLog& log() const { return log_; }
   const PoseGraph& graph() const { return graph_; }
   std::size_t accepted_loops() const { return accepted_.load(); }  // any thread
   const std::vector<double>& registration_ms() const { return registration_ms_; }
   const std::vector<double>& optimization_ms() const { return optimization_ms_; }
+  // Accepted loops added without a solve (pose_graph.skip_solve_loop_chi2).
+  std::size_t solves_skipped() const { return solves_skipped_; }
 
  private:
   std::vector<KeyframeView> submap_around(std::size_t loop_kf, std::size_t limit,
@@ -54,6 +59,8 @@ class LoopClosure {
   std::vector<std::size_t> loop_rows_;  // loops.csv row of each loop edge, in edge order
   std::atomic<std::size_t> accepted_{0};
   std::vector<double> registration_ms_, optimization_ms_;
+  std::size_t solves_skipped_ = 0;
+  bool unsolved_loops_ = false;
 };
 
 }  // namespace scfloam

@@ -153,7 +153,9 @@ nlohmann::json make_summary(const ScanSource& source, const RunResult& result) {
     for (const auto& row : result.loop_rows) accepted += row.verdict == LoopVerdict::kAccepted;
     summary["loops"] = {{"candidates", result.loop_rows.size()},
                         {"accepted", accepted},
-                        {"rejected", result.loop_rows.size() - accepted}};
+                        {"rejected", result.loop_rows.size() - accepted},
+                        // accepted without a graph solve: consistent with the estimate
+                        {"solves_skipped", result.loop_solves_skipped}};
   }
   // Accuracy against the source's ground truth, when it has one for every processed frame.
   const PoseList gt_lidar = source.ground_truth_lidar();

@@ -370,6 +370,7 @@ RunResult run_slam(const ScanSource& source, const SlamConfig& base_config,
     }
   }
   if (threads) threads->finish();
+  if (loops) closure.finish();
   progress.finish();
   if (wait_queue_ms.empty()) result.timing_ms.erase("wait_loop_queue");
 
@@ -380,6 +381,7 @@ RunResult run_slam(const ScanSource& source, const SlamConfig& base_config,
     result.timing_ms["loop_detection"] = detection.ms();
     result.timing_ms["loop_registration"] = closure.registration_ms();
     result.timing_ms["optimization"] = closure.optimization_ms();
+    result.loop_solves_skipped = closure.solves_skipped();
     result.loop_rows = closure.log().rows();
     result.graph = std::make_shared<PoseGraph>(closure.graph());
   }

@@ -17,6 +17,13 @@ struct PoseGraphConfig {
   // (chi-square, 6 dof: 22.46 is the 99.9 % quantile).
   double loop_outlier_chi2 = 22.46;
   int max_outlier_rounds = 3;
+  // A new loop whose squared whitened residual under the current estimate is below this is
+  // added without a solve: the graph already agrees with it (0.05: about 2 cm at the default
+  // 0.1 m sigma). On a revisited route most loops after the first one are like that, and a
+  // full solve of thousands of keyframes per loop made the closure stage the bottleneck of a
+  // long run (docs/robustness-long-run.md). The run ends with one solve if loops were added
+  // since the last. 0 = solve after every loop.
+  double skip_solve_loop_chi2 = 0.05;
   int max_iterations = 50;
 };
 

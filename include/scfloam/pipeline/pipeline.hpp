@@ -68,6 +68,7 @@ struct RunResult {
   bool interrupted = false;  // RunOptions::stop ended the run before the last scan
   // Loop modes only: every loop candidate with its verdict, the final graph.
   std::vector<LoopCandidate> loop_rows;
+  std::size_t loop_solves_skipped = 0;  // accepted loops the graph already agreed with
   std::shared_ptr<const PoseGraph> graph;
   PoseList keyframe_poses;  // final pose of every keyframe
   KeyframeStorageStats keyframe_storage;
