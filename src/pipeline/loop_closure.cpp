@@ -102,16 +102,15 @@ bool LoopClosure::add(const KeyframePtr& keyframe, const LoopQuery& detected) {
     accepted_ = graph_.loop_edge_count();
     return true;
   }
-  watch.restart();
-  const PoseGraphReport report = graph_.optimize(config_.pose_graph);
-  optimization_ms_.push_back(watch.elapsed_ms());
-  unsolved_loops_ = false;
-  publish(report);
+  solve();
   return true;
 }
 
 void LoopClosure::finish() {
-  if (!unsolved_loops_) return;
+  if (unsolved_loops_) solve();
+}
+
+void LoopClosure::solve() {
   Stopwatch watch;
   const PoseGraphReport report = graph_.optimize(config_.pose_graph);
   optimization_ms_.push_back(watch.elapsed_ms());

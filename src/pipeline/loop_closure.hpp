@@ -43,6 +43,8 @@ class LoopClosure {
                                           std::size_t& loop_index) const;
   // Logs the loops a solve switched off and hands the poses to the store.
   void publish(const PoseGraphReport& report);
+  // Whole-graph solve, timed, then publish.
+  void solve();
   // The gate in the graph (loop_detection.gate_drift_fraction > 0): distances under the
   // optimized poses, uncertainty growing with the graph path between the two keyframes.
   void apply_path_gate(LoopQuery& query, std::size_t current_kf);

@@ -102,26 +102,16 @@ NormalEquationCost::NormalEquationCost(const std::vector<EdgeMatch>& edges,
 
 namespace {
 
-// One residual row r with Jacobian row j (tangent [omega; v]) added to the sums.
-inline void add_row(const double* j, double r, double* H, double* g) {
+// One residual row r with Jacobian row j (tangent [omega; v]) added to the upper triangle of
+// J^T J (H, 21 entries) and to J^T r (g).
+template <typename Row>
+inline void add_row(const Row& j, double r, double* H, double* g) {
   int k = 0;
   for (int a = 0; a < 6; ++a) {
     g[a] += j[a] * r;
     for (int b = a; b < 6; ++b) H[k++] += j[a] * j[b];
   }
 }
-
-// Huber's rho folded into a residual of norm m (see robustify_huber): r *= scale; the
-// Jacobian is multiplied by scale across r and by `along` in r's direction.
-struct HuberFold {
-  double scale = 1, along = 1;
-  HuberFold(double delta, double m) {
-    if (m <= delta) return;
-    const double rho = 2 * delta * m - delta * delta;
-    scale = std::sqrt(rho) / m;
-    along = delta / std::sqrt(rho);
-  }
-};
 
 }  // namespace
 
@@ -139,43 +129,31 @@ void NormalEquationCost::sums(const Eigen::Matrix3d& R, const Eigen::Vector3d& t
     double squared_norm = 0;
     const std::size_t begin = b * kBlock, end = std::min(total, begin + kBlock);
     for (std::size_t i = begin; i < std::min(end, n_edges); ++i) {
-      // The point-to-line vector in the line's perpendicular basis E (two rows): row k is
-      // e_k . (Rp + t - c), its Jacobian [(Rp x e_k)^T, e_k^T] (as edge_residual's, times E).
+      // The point-to-line vector in the line's perpendicular basis E (two rows, as FeatureCost):
+      // row k is e_k . (Rp + t - c), its Jacobian [(Rp x e_k)^T, e_k^T] (edge_residual's, times E).
       const EdgeMatch& m = edges_[i];
       const Eigen::Matrix<double, 2, 3>& E = edge_bases_[i];
       const Eigen::Vector3d Rp = R * m.point_lidar;
       Eigen::Vector2d r = E * (Rp + t - m.line_point);
-      const double norm = r.norm();
-      const HuberFold f(delta_, norm);
-      r *= f.scale;
+      Eigen::Matrix<double, 2, 6> J;
+      if (with_jacobian)
+        for (int k = 0; k < 2; ++k) {
+          J.block<1, 3>(k, 0) = Rp.cross(E.row(k).transpose()).transpose();
+          J.block<1, 3>(k, 3) = E.row(k);
+        }
+      robustify_huber<2>(delta_, r, with_jacobian ? &J : nullptr);
       squared_norm += r.squaredNorm();
       if (!with_jacobian) continue;
-      Eigen::Matrix<double, 2, 6, Eigen::RowMajor> J;
-      for (int k = 0; k < 2; ++k) {
-        const Eigen::Vector3d e = E.row(k).transpose();
-        J.block<1, 3>(k, 0) = f.scale * Rp.cross(e).transpose();
-        J.block<1, 3>(k, 3) = f.scale * e.transpose();
-      }
-      if (f.along != f.scale) {  // the component along r: `along` instead of `scale`
-        const Eigen::Vector2d u = r / r.norm();
-        const Eigen::Matrix<double, 1, 6> uJ = u.transpose() * J;
-        J += (f.along / f.scale - 1) * u * uJ;
-      }
-      add_row(J.data(), r[0], s.H, s.g);
-      add_row(J.data() + 6, r[1], s.H, s.g);
+      add_row(J.row(0), r[0], s.H, s.g);
+      add_row(J.row(1), r[1], s.H, s.g);
     }
     for (std::size_t i = std::max(begin, n_edges); i < end; ++i) {
-      const PlaneMatch& m = planes_[i - n_edges];
-      const Eigen::Vector3d Rp = R * m.point_lidar;
-      const double r = m.normal.dot(Rp + t) + m.offset;
-      const HuberFold f(delta_, std::abs(r));
-      squared_norm += f.scale * f.scale * r * r;
-      if (!with_jacobian) continue;
-      // One row: its whole Jacobian lies along r.
-      const double w = f.along;
-      const Eigen::Vector3d c = Rp.cross(m.normal);
-      const double j[6] = {w * c.x(), w * c.y(), w * c.z(), w * m.normal.x(), w * m.normal.y(), w * m.normal.z()};
-      add_row(j, f.scale * r, s.H, s.g);
+      Jacobian16 J;
+      Eigen::Matrix<double, 1, 1> r(
+          plane_residual(planes_[i - n_edges], R, t, with_jacobian ? &J : nullptr));
+      robustify_huber<1>(delta_, r, with_jacobian ? &J : nullptr);
+      squared_norm += r[0] * r[0];
+      if (with_jacobian) add_row(J, r[0], s.H, s.g);
     }
     s.squared_norm = squared_norm;
   };
