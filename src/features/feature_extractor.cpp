@@ -30,6 +30,20 @@ inline float elevation_deg(float z, float horizontal_range) {
 
 }  // namespace
 
+void correct_elevation(FeatureCloud& points, double angle_deg) {
+  if (angle_deg == 0) return;
+  const float c = static_cast<float>(std::cos(angle_deg * M_PI / 180.0));
+  const float s = static_cast<float>(std::sin(angle_deg * M_PI / 180.0));
+  for (Eigen::Vector3f& p : points) {
+    const float horizontal = std::sqrt(p.x() * p.x() + p.y() * p.y());
+    if (horizontal < 1e-3f) continue;
+    const float new_horizontal = horizontal * c - p.z() * s;
+    p.z() = p.z() * c + horizontal * s;
+    p.x() *= new_horizontal / horizontal;
+    p.y() *= new_horizontal / horizontal;
+  }
+}
+
 void ring_curvature(const Eigen::Vector3f* p, int n, int hw, float* curvature) {
   std::fill(curvature, curvature + n, 0.f);
   if (n < 2 * hw + 1) return;
@@ -66,33 +80,54 @@ void FeatureExtractor::assign_rings(const std::vector<LidarPoint>& points, bool 
   ring_of_.resize(n);
   const float min_r2 = static_cast<float>(pre_.min_range_m * pre_.min_range_m);
   const float max_r2 = static_cast<float>(pre_.max_range_m * pre_.max_range_m);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const auto& range) {
-    for (std::size_t i = range.begin(); i != range.end(); ++i) {
-      const LidarPoint& p = points[i];
-      const float r2 = p.x * p.x + p.y * p.y;
-      std::int16_t ring = -1;
-      if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z) && r2 > 0 && r2 >= min_r2 &&
-          r2 <= max_r2) {
-        if (use_ring_field) {
-          ring = (p.ring >= 0 && p.ring < beams_) ? p.ring : -1;
-        } else {
-          ring = static_cast<std::int16_t>(
-              ring_from_elevation_deg(model_, elevation_deg(p.z, std::sqrt(r2))));
+  // A stable counting sort by ring, in parallel: each fixed block counts its rings, a prefix
+  // over (ring, block) gives every block its write offsets, and each block scatters its points
+  // in input (acquisition) order. Fixed blocks keep the result independent of the scheduler.
+  constexpr std::size_t kBlock = 8192;
+  const std::size_t blocks = (n + kBlock - 1) / kBlock;
+  const std::size_t R = static_cast<std::size_t>(beams_);
+  block_counts_.assign(blocks * R, 0);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks, 1), [&](const auto& range) {
+    for (std::size_t b = range.begin(); b != range.end(); ++b) {
+      int* counts = block_counts_.data() + b * R;
+      for (std::size_t i = b * kBlock, e = std::min(n, i + kBlock); i != e; ++i) {
+        const LidarPoint& p = points[i];
+        const float r2 = p.x * p.x + p.y * p.y;
+        std::int16_t ring = -1;
+        if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z) && r2 > 0 &&
+            r2 >= min_r2 && r2 <= max_r2) {
+          if (use_ring_field) {
+            ring = (p.ring >= 0 && p.ring < beams_) ? p.ring : -1;
+          } else {
+            ring = static_cast<std::int16_t>(
+                ring_from_elevation_deg(model_, elevation_deg(p.z, std::sqrt(r2))));
+          }
         }
+        ring_of_[i] = ring;
+        if (ring >= 0) ++counts[ring];
       }
-      ring_of_[i] = ring;
     }
   });
-  // Counting sort by ring, keeping the input (acquisition) order within each ring.
-  std::fill(ring_begin_.begin(), ring_begin_.end(), 0);
-  for (std::size_t i = 0; i < n; ++i)
-    if (ring_of_[i] >= 0) ++ring_begin_[ring_of_[i] + 1];
-  for (int r = 0; r < beams_; ++r) ring_begin_[r + 1] += ring_begin_[r];
-  ordered_.resize(ring_begin_[beams_]);
-  std::vector<int>& cursor = candidates_[0];  // reuse a scratch vector as write cursors
-  cursor.assign(ring_begin_.begin(), ring_begin_.end() - 1);
-  for (std::size_t i = 0; i < n; ++i)
-    if (ring_of_[i] >= 0) ordered_[cursor[ring_of_[i]]++] = Eigen::Vector3f(points[i].x, points[i].y, points[i].z);
+  // Turn counts into write offsets, ring-major: ring r's points from block 0, then block 1, ...
+  int offset = 0;
+  for (std::size_t r = 0; r < R; ++r) {
+    ring_begin_[r] = offset;
+    for (std::size_t b = 0; b < blocks; ++b) {
+      const int count = block_counts_[b * R + r];
+      block_counts_[b * R + r] = offset;
+      offset += count;
+    }
+  }
+  ring_begin_[R] = offset;
+  ordered_.resize(static_cast<std::size_t>(offset));
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks, 1), [&](const auto& range) {
+    for (std::size_t b = range.begin(); b != range.end(); ++b) {
+      int* cursor = block_counts_.data() + b * R;
+      for (std::size_t i = b * kBlock, e = std::min(n, i + kBlock); i != e; ++i)
+        if (ring_of_[i] >= 0)
+          ordered_[cursor[ring_of_[i]]++] = Eigen::Vector3f(points[i].x, points[i].y, points[i].z);
+    }
+  });
 }
 
 void FeatureExtractor::order_ring_by_azimuth(int ring) {
@@ -179,6 +214,8 @@ void FeatureExtractor::select_in_ring(int ring) {
     for (int i = sb; i < se; ++i)
       if (!picked[i]) planes.push_back(p[i]);
   }
+  correct_elevation(edges, pre_.elevation_correction_deg);
+  correct_elevation(planes, pre_.elevation_correction_deg);
 }
 
 void FeatureExtractor::extract(const std::vector<LidarPoint>& points, bool use_ring_field,

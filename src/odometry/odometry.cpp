@@ -75,22 +75,6 @@ Eigen::Isometry3d scaled_motion(const Eigen::Isometry3d& T_delta, double ratio) 
   return out;
 }
 
-// Rotates each point up by `angle_deg` in its own vertical plane (after ring assignment, which
-// reads the sensor's own elevations).
-void correct_elevation(FeatureCloud& points, double angle_deg) {
-  if (angle_deg == 0) return;
-  const float c = static_cast<float>(std::cos(angle_deg * M_PI / 180.0));
-  const float s = static_cast<float>(std::sin(angle_deg * M_PI / 180.0));
-  for (Eigen::Vector3f& p : points) {
-    const float horizontal = std::hypot(p.x(), p.y());
-    if (horizontal < 1e-3f) continue;
-    const float new_horizontal = horizontal * c - p.z() * s;
-    p.z() = p.z() * c + horizontal * s;
-    p.x() *= new_horizontal / horizontal;
-    p.y() *= new_horizontal / horizontal;
-  }
-}
-
 // The scan aligned to the previous frame alone with a wide search radius, from `T_pred`: the
 // local map's radius (max_neighbor_dist_m, ~1 m) is the basin of the fine solve, and the guess
 // made without a velocity (frame 1 starts from standing still; a car at 12 m/s is 1.2 m on)
@@ -144,8 +128,6 @@ OdometryResult Odometry::process(const Scan& scan) {
     points = &s.deskewed;
   }
   s.extractor.extract(*points, scan.has_ring && c.rings.use_ring_field, s.raw_edges, s.raw_planes);
-  correct_elevation(s.raw_edges, c.preprocess.elevation_correction_deg);
-  correct_elevation(s.raw_planes, c.preprocess.elevation_correction_deg);
   s.edge_filter.filter(s.raw_edges, c.features.edge_leaf_m, result.edges);
   s.plane_filter.filter(s.raw_planes, c.features.plane_leaf_m, result.planes);
   result.features_ms = watch.elapsed_ms();

@@ -52,6 +52,7 @@ std::vector<LidarPoint> corner_room_scan() {
 TEST(FeatureExtractor, CornerSceneEdgesOnTheCornersPlanesOnTheWalls) {
   OdometryConfig c;
   c.preprocess.max_range_m = 100;
+  c.preprocess.elevation_correction_deg = 0;  // the scene's exact geometry (next test: with it)
   FeatureExtractor extractor(c.preprocess, c.rings, c.features);
   FeatureCloud edges, planes;
   extractor.extract(corner_room_scan(), /*use_ring_field=*/true, edges, planes);
@@ -74,6 +75,35 @@ TEST(FeatureExtractor, CornerSceneEdgesOnTheCornersPlanesOnTheWalls) {
   }
   // At most 20 edges per sector, 6 sectors, 64 rings.
   EXPECT_LE(edges.size(), 64u * 6u * 20u);
+}
+
+// The elevation correction is applied to the selected features, after ring assignment and
+// selection: the same features as without it, each rotated up in its own vertical plane.
+TEST(FeatureExtractor, ElevationCorrectionRotatesTheSelectedFeaturesUp) {
+  OdometryConfig c;
+  c.preprocess.max_range_m = 100;
+  c.preprocess.elevation_correction_deg = 0;
+  FeatureExtractor plain(c.preprocess, c.rings, c.features);
+  c.preprocess.elevation_correction_deg = 0.22;
+  FeatureExtractor corrected(c.preprocess, c.rings, c.features);
+  FeatureCloud e0, p0, e1, p1;
+  plain.extract(corner_room_scan(), true, e0, p0);
+  corrected.extract(corner_room_scan(), true, e1, p1);
+  ASSERT_EQ(e0.size(), e1.size());
+  ASSERT_EQ(p0.size(), p1.size());
+  const double angle = 0.22 * M_PI / 180.0;
+  for (std::size_t i = 0; i < p0.size(); i += 37) {
+    const Eigen::Vector3d a = p0[i].cast<double>(), b = p1[i].cast<double>();
+    // Same bearing and range, elevation up by the angle.
+    EXPECT_NEAR(std::atan2(b.y(), b.x()), std::atan2(a.y(), a.x()), 1e-5);
+    EXPECT_NEAR(b.norm(), a.norm(), 1e-4 * a.norm());
+    const double up = std::atan2(b.z(), b.head<2>().norm()) - std::atan2(a.z(), a.head<2>().norm());
+    EXPECT_NEAR(up, angle, 1e-5);
+  }
+  for (std::size_t i = 0; i < e0.size(); ++i) {
+    const Eigen::Vector3d a = e0[i].cast<double>(), b = e1[i].cast<double>();
+    EXPECT_NEAR(std::atan2(b.z(), b.head<2>().norm()) - std::atan2(a.z(), a.head<2>().norm()), angle, 1e-5);
+  }
 }
 
 TEST(FeatureExtractor, RangeCropDropsNearFarAndNonFinitePoints) {

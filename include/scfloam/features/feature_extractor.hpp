@@ -1,5 +1,6 @@
 // F-LOAM feature extraction: range crop, rings, curvature per ring, edge selection per sector
-// with neighbour suppression; the remaining points are plane points. Output is not yet
+// with neighbour suppression; the remaining points are plane points, and both get the
+// preprocess config's elevation correction. Output is not yet
 // voxel-downsampled (the odometry does that with registration/voxel_filter.hpp).
 #pragma once
 
@@ -15,6 +16,11 @@ namespace scfloam {
 // Curvature of each point of one ring in F-LOAM's unit: squared norm of (sum of the
 // 2*half_window neighbours - 2*half_window * p). Points within half_window of either end get 0.
 void ring_curvature(const Eigen::Vector3f* points, int n, int half_window, float* curvature);
+
+// Rotates each point up by `angle_deg` in its own vertical plane (KITTI's beams read ~0.22 deg
+// low); 0 leaves the points alone. Applied after ring assignment, which reads the sensor's own
+// elevations.
+void correct_elevation(FeatureCloud& points, double angle_deg);
 
 struct FeatureStats {
   int input_points = 0;
@@ -47,6 +53,7 @@ class FeatureExtractor {
 
   std::vector<std::int16_t> ring_of_;        // per input point, -1 = dropped
   std::vector<int> ring_begin_;              // offsets into ordered_ (beams_ + 1)
+  std::vector<int> block_counts_;            // per (input block, ring): count, then cursor
   std::vector<Eigen::Vector3f> ordered_;     // kept points grouped by ring
   std::vector<float> curvature_;
   std::vector<char> picked_, unreliable_;

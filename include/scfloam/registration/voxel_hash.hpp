@@ -16,10 +16,15 @@ inline std::uint64_t voxel_key(int ix, int iy, int iz) {
          ((static_cast<std::uint64_t>(iy) & mask) << 21) | (static_cast<std::uint64_t>(iz) & mask);
 }
 
+// floor() for |x| < 2^31, without the libm call that portable (pre-SSE4.1) x86-64 code makes.
+inline int floor_to_int(float x) {
+  const int i = static_cast<int>(x);  // truncates toward zero
+  return i - (x < static_cast<float>(i));
+}
+
 inline Eigen::Vector3i voxel_coords(const Eigen::Vector3f& p, float inv_size) {
-  return Eigen::Vector3i(static_cast<int>(std::floor(p.x() * inv_size)),
-                         static_cast<int>(std::floor(p.y() * inv_size)),
-                         static_cast<int>(std::floor(p.z() * inv_size)));
+  return Eigen::Vector3i(floor_to_int(p.x() * inv_size), floor_to_int(p.y() * inv_size),
+                         floor_to_int(p.z() * inv_size));
 }
 
 // key -> uint32 index; linear probing, power-of-two capacity, no erase (callers rebuild).
