@@ -117,6 +117,11 @@ struct PipelineConfig {
   // output (tests, evaluation). Otherwise the stages run on their own threads.
   bool deterministic = false;
   int queue_capacity = 256;        // keyframes waiting between stages
+  // While keyframes wait for the closure stage, an accepted loop's graph solve waits too, for
+  // at most this many loops: the backlog is worked off and solved once (a whole-graph solve
+  // per loop is slower than real time on graphs of thousands of keyframes). 0: solve after
+  // every loop. Deterministic mode has no queue and always solves per loop.
+  int max_deferred_loops = 16;
   bool rebuild_map_after_loop = true;  // the odometry continues on the corrected map
   // A correction that moves no keyframe near the odometry by more than this (relative to the
   // newest keyframe; rotation counted at 30 m) leaves the map as it is, unless the odometry

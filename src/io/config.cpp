@@ -123,6 +123,7 @@ std::vector<Binding> bindings(SlamConfig& c) {
       {pg, "loop_outlier_chi2", &g.loop_outlier_chi2},
       {pg, "max_outlier_rounds", &g.max_outlier_rounds},
       {pg, "skip_solve_loop_chi2", &g.skip_solve_loop_chi2},
+      {pg, "solve_window_margin_keyframes", &g.solve_window_margin_keyframes},
       {pg, "max_iterations", &g.max_iterations},
   });
   auto& p = c.pipeline;
@@ -130,6 +131,7 @@ std::vector<Binding> bindings(SlamConfig& c) {
   table.insert(table.end(), {
       {pl, "deterministic", &p.deterministic},
       {pl, "queue_capacity", &p.queue_capacity},
+      {pl, "max_deferred_loops", &p.max_deferred_loops},
       {pl, "rebuild_map_after_loop", &p.rebuild_map_after_loop},
       {pl, "map_rebuild_min_shift_m", &p.map_rebuild_min_shift_m},
       {pl, "raw_leaf_m", &p.raw_leaf_m},
@@ -221,6 +223,7 @@ void check_ranges(const SlamConfig& c, const std::filesystem::path& path) {
   require(d.gate_drift_fraction >= 0, "loop_detection.gate_drift_fraction", ">= 0");
   require(c.loop_registration.icp_leaf_m > 0, "loop_registration.icp_leaf_m", "> 0");
   require(c.pipeline.queue_capacity >= 1, "pipeline.queue_capacity", ">= 1");
+  require(c.pipeline.max_deferred_loops >= 0, "pipeline.max_deferred_loops", ">= 0");
   require(c.pipeline.raw_leaf_m > 0, "pipeline.raw_leaf_m", "> 0");
   require(c.pipeline.resident_keyframes >= 0, "pipeline.resident_keyframes", ">= 0");
   require(c.pipeline.map_rebuild_cell_m >= 0, "pipeline.map_rebuild_cell_m", ">= 0");

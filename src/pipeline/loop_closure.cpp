@@ -1,6 +1,7 @@
 #include "pipeline/loop_closure.hpp"
 
 #include <cstdlib>
+#include <limits>
 
 #include "scfloam/stats.hpp"
 
@@ -8,7 +9,10 @@ namespace scfloam {
 
 LoopClosure::LoopClosure(const SlamConfig& config, LoopRegistrationMethod method,
                          KeyframeStore& store)
-    : config_(config), method_(method), store_(store) {}
+    : config_(config),
+      method_(method),
+      store_(store),
+      earliest_partner_(std::numeric_limits<std::size_t>::max()) {}
 
 std::vector<KeyframeView> LoopClosure::submap_around(std::size_t loop_kf, std::size_t limit,
                                                      std::size_t& loop_index) const {
@@ -62,7 +66,7 @@ void LoopClosure::apply_path_gate(LoopQuery& query, std::size_t current_kf) {
       [&](const LoopCandidate&) { return d.gate_base_m + d.gate_drift_fraction * path_m[next++]; });
 }
 
-bool LoopClosure::add(const KeyframePtr& keyframe, const LoopQuery& detected) {
+bool LoopClosure::add(const KeyframePtr& keyframe, const LoopQuery& detected, bool backlog) {
   const std::size_t k = keyframe->index;
   graph_.add_node(store_.current_pose(k));
   if (k > 0) graph_.add_odometry_edge(k - 1, k, keyframe->T_prev_current, config_.pose_graph);
@@ -95,9 +99,18 @@ bool LoopClosure::add(const KeyframePtr& keyframe, const LoopQuery& detected) {
   // Edge from the current keyframe to the loop keyframe.
   graph_.add_loop_edge(k, loop_kf, match.T_loop_current.inverse(), config_.pose_graph);
   loop_rows_.push_back(*row);
+  earliest_partner_ = std::min(earliest_partner_, loop_kf);
   if (graph_.edge_chi2(graph_.edges().size() - 1) < config_.pose_graph.skip_solve_loop_chi2) {
     // Already consistent: the edge joins the graph for the next solve; the poses stand.
     ++solves_skipped_;
+    unsolved_loops_ = true;
+    accepted_ = graph_.loop_edge_count();
+    return true;
+  }
+  const int max_deferred = config_.pipeline.max_deferred_loops;
+  if (backlog && pending_deferred_ < static_cast<std::size_t>(std::max(max_deferred, 0))) {
+    ++pending_deferred_;
+    ++solves_deferred_;
     unsolved_loops_ = true;
     accepted_ = graph_.loop_edge_count();
     return true;
@@ -106,15 +119,29 @@ bool LoopClosure::add(const KeyframePtr& keyframe, const LoopQuery& detected) {
   return true;
 }
 
-void LoopClosure::finish() {
-  if (unsolved_loops_) solve();
+void LoopClosure::solve_deferred() {
+  if (pending_deferred_ > 0) solve();
 }
 
-void LoopClosure::solve() {
+void LoopClosure::finish() {
+  if (unsolved_loops_ || whole_solve_due_) solve(/*whole_graph=*/true);
+}
+
+void LoopClosure::solve(bool whole_graph) {
+  const int margin = config_.pose_graph.solve_window_margin_keyframes;
+  std::size_t first_free = 0;
+  if (!whole_graph && margin >= 0 && earliest_partner_ != std::numeric_limits<std::size_t>::max())
+    first_free = earliest_partner_ > static_cast<std::size_t>(margin)
+                     ? earliest_partner_ - static_cast<std::size_t>(margin)
+                     : 0;
   Stopwatch watch;
-  const PoseGraphReport report = graph_.optimize(config_.pose_graph);
+  const PoseGraphReport report = graph_.optimize(config_.pose_graph, first_free);
   optimization_ms_.push_back(watch.elapsed_ms());
+  whole_solve_due_ = first_free > 0;
+  window_solves_ += first_free > 0;
+  earliest_partner_ = std::numeric_limits<std::size_t>::max();
   unsolved_loops_ = false;
+  pending_deferred_ = 0;
   publish(report);
 }
 

@@ -24,8 +24,13 @@ class LoopClosure {
   LoopClosure(const SlamConfig& config, LoopRegistrationMethod method, KeyframeStore& store);
 
   // Adds keyframe `keyframe` (already in the store) and handles the loop its query proposed.
-  // Returns true when the graph was re-optimized (the store then holds corrected poses).
-  bool add(const KeyframePtr& keyframe, const LoopQuery& query);
+  // Returns true when the loop was accepted. An accepted loop the graph does not already
+  // agree with is solved at once, unless `backlog` (keyframes are waiting for this stage) and
+  // fewer than pipeline.max_deferred_loops solves are pending: then solve_deferred() or the
+  // next add() without a backlog solves them together.
+  bool add(const KeyframePtr& keyframe, const LoopQuery& query, bool backlog = false);
+  // One solve for the deferred loops, if any (the store then holds corrected poses).
+  void solve_deferred();
   // End of the run: one solve if loops were added without one since the last (their edges
   // then inform the final poses).
   void finish();
@@ -37,14 +42,19 @@ class LoopClosure {
   const std::vector<double>& optimization_ms() const { return optimization_ms_; }
   // Accepted loops added without a solve (pose_graph.skip_solve_loop_chi2).
   std::size_t solves_skipped() const { return solves_skipped_; }
+  // Accepted loops whose solve waited for a backlog to clear, and the solves that ended a wait.
+  std::size_t solves_deferred() const { return solves_deferred_; }
+  // Solves that freed only a window of the graph (pose_graph.solve_window_margin_keyframes).
+  std::size_t window_solves() const { return window_solves_; }
 
  private:
   std::vector<KeyframeView> submap_around(std::size_t loop_kf, std::size_t limit,
                                           std::size_t& loop_index) const;
   // Logs the loops a solve switched off and hands the poses to the store.
   void publish(const PoseGraphReport& report);
-  // Whole-graph solve, timed, then publish.
-  void solve();
+  // Timed solve, then publish: a window from the earliest pending loop partner (less the
+  // margin) to the newest node, or with `whole_graph` every node.
+  void solve(bool whole_graph = false);
   // The gate in the graph (loop_detection.gate_drift_fraction > 0): distances under the
   // optimized poses, uncertainty growing with the graph path between the two keyframes.
   void apply_path_gate(LoopQuery& query, std::size_t current_kf);
@@ -61,7 +71,10 @@ class LoopClosure {
   std::vector<std::size_t> loop_rows_;  // loops.csv row of each loop edge, in edge order
   std::atomic<std::size_t> accepted_{0};
   std::vector<double> registration_ms_, optimization_ms_;
-  std::size_t solves_skipped_ = 0;
+  std::size_t solves_skipped_ = 0, solves_deferred_ = 0, window_solves_ = 0;
+  std::size_t pending_deferred_ = 0;  // deferred loops not yet solved
+  std::size_t earliest_partner_;      // of the loops added since the last solve
+  bool whole_solve_due_ = false;      // a window solve left older nodes out
   bool unsolved_loops_ = false;
 };
 

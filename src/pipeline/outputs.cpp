@@ -155,7 +155,8 @@ nlohmann::json make_summary(const ScanSource& source, const RunResult& result) {
                         {"accepted", accepted},
                         {"rejected", result.loop_rows.size() - accepted},
                         // accepted without a graph solve: consistent with the estimate
-                        {"solves_skipped", result.loop_solves_skipped}};
+                        {"solves_skipped", result.loop_solves_skipped},
+                        {"solves_deferred", result.loop_solves_deferred}};
   }
   // Accuracy against the source's ground truth, when it has one for every processed frame.
   const PoseList gt_lidar = source.ground_truth_lidar();

@@ -133,7 +133,9 @@ class LoopThreads {
       guarded([&] {
         while (auto item = to_closure_.pop()) {
           const KeyframeStore::Hold hold(store);  // its submap views point into clouds
-          closure.add(item->keyframe, item->query);
+          const bool backlog = to_closure_.size() > 0;
+          closure.add(item->keyframe, item->query, backlog);
+          if (!backlog) closure.solve_deferred();  // caught up: one solve for the waiting loops
         }
       });
     });
@@ -382,6 +384,7 @@ RunResult run_slam(const ScanSource& source, const SlamConfig& base_config,
     result.timing_ms["loop_registration"] = closure.registration_ms();
     result.timing_ms["optimization"] = closure.optimization_ms();
     result.loop_solves_skipped = closure.solves_skipped();
+    result.loop_solves_deferred = closure.solves_deferred();
     result.loop_rows = closure.log().rows();
     result.graph = std::make_shared<PoseGraph>(closure.graph());
   }

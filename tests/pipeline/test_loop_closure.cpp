@@ -18,46 +18,70 @@
 
 using namespace scfloam;
 
-TEST(LoopClosure, CorrectsADriftingOdometryOnASimulatedDrive) {
-  const SlamConfig config;
-  const sim::Scenario scenario = sim::make_loops_scenario(3, 1000);
-  sim::SensorModel sensor = sim::sensor_preset("hdl64");
-  sensor.columns = 1000;  // thinner rings keep the test fast; features still form
-  const sim::BeamCalibration calibration = sim::draw_beam_calibration(sensor, 3);
+namespace {
 
-  PoseList gt;
-  for (std::size_t k = 0; k < scenario.frames; ++k) gt.push_back(scenario.frame_pose(k));
-  const PoseList odometry = test::drifting_odometry(gt, 0.01, 1.0);  // 1 % scale, 1 deg per 100 m
+// The drive, its drifting odometry and its keyframes (rendered once per drift).
+struct Drive {
+  PoseList gt, odometry;
+  std::vector<std::size_t> frames;  // keyframe -> frame
+  std::vector<std::shared_ptr<Keyframe>> keyframes;
+};
 
-  // Keyframes on the odometry, as the pipeline picks them.
-  std::vector<std::size_t> frames;
-  KeyframeSelector selector(config.loop_detection.keyframe_distance_m,
-                            config.loop_detection.keyframe_angle_deg * M_PI / 180.0);
-  for (std::size_t k = 0; k < odometry.size(); ++k)
-    if (selector.update(odometry[k])) frames.push_back(k);
-  std::vector<std::shared_ptr<Keyframe>> keyframes(frames.size());
-  tbb::parallel_for(std::size_t{0}, frames.size(), [&](std::size_t i) {
-    sim::SweepPoses poses;
-    poses.T_world_lidar = gt[frames[i]];
-    const Scan scan = sim::render_scan(scenario.world, sensor, calibration, poses, 3, frames[i]);
-    FeatureExtractor extractor(config.odometry.preprocess, config.odometry.rings,
-                               config.odometry.features);
-    FeatureCloud edges, planes;
-    extractor.extract(scan.points, false, edges, planes);
-    auto kf = std::make_shared<Keyframe>();
-    kf->index = i;
-    kf->frame = frames[i];
-    kf->edges = voxel_downsample(edges, config.odometry.features.edge_leaf_m);
-    kf->planes = voxel_downsample(planes, config.odometry.features.plane_leaf_m);
-    if (i > 0) kf->T_prev_current = odometry[frames[i - 1]].inverse() * odometry[frames[i]];
-    keyframes[i] = kf;
-  });
+Drive make_drive(double scale_error, double yaw_bias_deg_per_100m) {
+  {
+    const SlamConfig config;
+    const sim::Scenario scenario = sim::make_loops_scenario(3, 1000);
+    sim::SensorModel sensor = sim::sensor_preset("hdl64");
+    sensor.columns = 1000;  // thinner rings keep the test fast; features still form
+    const sim::BeamCalibration calibration = sim::draw_beam_calibration(sensor, 3);
+    Drive out;
+    for (std::size_t k = 0; k < scenario.frames; ++k) out.gt.push_back(scenario.frame_pose(k));
+    out.odometry = test::drifting_odometry(out.gt, scale_error, yaw_bias_deg_per_100m);
+    // Keyframes on the odometry, as the pipeline picks them.
+    KeyframeSelector selector(config.loop_detection.keyframe_distance_m,
+                              config.loop_detection.keyframe_angle_deg * M_PI / 180.0);
+    for (std::size_t k = 0; k < out.odometry.size(); ++k)
+      if (selector.update(out.odometry[k])) out.frames.push_back(k);
+    out.keyframes.resize(out.frames.size());
+    tbb::parallel_for(std::size_t{0}, out.frames.size(), [&](std::size_t i) {
+      sim::SweepPoses poses;
+      poses.T_world_lidar = out.gt[out.frames[i]];
+      const Scan scan =
+          sim::render_scan(scenario.world, sensor, calibration, poses, 3, out.frames[i]);
+      FeatureExtractor extractor(config.odometry.preprocess, config.odometry.rings,
+                                 config.odometry.features);
+      FeatureCloud edges, planes;
+      extractor.extract(scan.points, false, edges, planes);
+      auto kf = std::make_shared<Keyframe>();
+      kf->index = i;
+      kf->frame = out.frames[i];
+      kf->edges = voxel_downsample(edges, config.odometry.features.edge_leaf_m);
+      kf->planes = voxel_downsample(planes, config.odometry.features.plane_leaf_m);
+      if (i > 0)
+        kf->T_prev_current = out.odometry[out.frames[i - 1]].inverse() * out.odometry[out.frames[i]];
+      out.keyframes[i] = kf;
+    });
+    return out;
+  }
+}
 
-  KeyframeStore store;
-  LoopClosure closure(config, LoopRegistrationMethod::kFeatures, store);
+const Drive& drifting_drive() {  // 1 % scale, 1 deg per 100 m
+  static const Drive d = make_drive(0.01, 1.0);
+  return d;
+}
+
+const Drive& accurate_drive() {  // 0.05 % scale, 0.02 deg per 100 m: loops find little to fix
+  static const Drive d = make_drive(0.0005, 0.02);
+  return d;
+}
+
+// Feeds the drive's keyframes through detection and closure, as the pipeline's stages do;
+// `backlog`: every keyframe is handled as if more were waiting (the threaded pipeline behind).
+void close_loops(const Drive& drive, const SlamConfig& config, bool backlog,
+                 KeyframeStore& store, LoopClosure& closure) {
   LoopDetector detector(config.loop_detection);
   std::uint64_t seen = 0;
-  for (const auto& kf : keyframes) {
+  for (const auto& kf : drive.keyframes) {
     store.add(kf);
     if (store.version() != seen) {  // the gate works on corrected poses
       seen = store.version();
@@ -65,37 +89,119 @@ TEST(LoopClosure, CorrectsADriftingOdometryOnASimulatedDrive) {
       poses.resize(detector.size());
       detector.update_poses(poses);
     }
-    closure.add(kf, detector.add_keyframe(static_cast<std::int64_t>(kf->frame),
-                                          store.current_pose(kf->index), kf->edges, kf->planes));
+    closure.add(kf,
+                detector.add_keyframe(static_cast<std::int64_t>(kf->frame),
+                                      store.current_pose(kf->index), kf->edges, kf->planes),
+                backlog);
   }
-
-  // Loops the graph already agreed with were added without a solve; the end solves once.
   closure.finish();
-  EXPECT_GT(closure.solves_skipped(), 0u);
-  EXPECT_LT(closure.optimization_ms().size(), closure.accepted_loops());
-  // After it every active loop edge, solved or not, fits the final graph.
+}
+
+struct Accuracy {
+  double ate_odometry, ate_corrected;
+};
+
+Accuracy keyframe_accuracy(const Drive& d, const KeyframeStore& store) {
+  PoseList gt_kf, odom_kf;
+  for (std::size_t f : d.frames) {
+    gt_kf.push_back(d.gt[f]);
+    odom_kf.push_back(d.odometry[f]);
+  }
+  return {ate_rmse_m(gt_kf, odom_kf), ate_rmse_m(gt_kf, store.current_poses())};
+}
+
+}  // namespace
+
+TEST(LoopClosure, CorrectsADriftingOdometryOnASimulatedDrive) {
+  const SlamConfig config;
+  const Drive& d = drifting_drive();
+  KeyframeStore store;
+  LoopClosure closure(config, LoopRegistrationMethod::kFeatures, store);
+  close_loops(d, config, /*backlog=*/false, store, closure);
+
+  EXPECT_EQ(closure.solves_deferred(), 0u);  // no backlog, no waiting
+  EXPECT_GT(closure.window_solves(), 0u);    // later loops solved a window of the graph
+  // Every active loop edge, solved or not, fits the final graph.
   const PoseGraph& graph = closure.graph();
   for (std::size_t e = 0; e < graph.edges().size(); ++e)
     if (graph.edges()[e].is_loop && graph.edges()[e].active) {
       EXPECT_LT(graph.edge_chi2(e), config.pose_graph.loop_outlier_chi2) << e;
     }
 
-  PoseList gt_kf, odom_kf;
-  for (std::size_t f : frames) {
-    gt_kf.push_back(gt[f]);
-    odom_kf.push_back(odometry[f]);
-  }
-  const PoseList corrected = store.current_poses();
-  const double ate_odometry = ate_rmse_m(gt_kf, odom_kf);
-  const double ate_corrected = ate_rmse_m(gt_kf, corrected);
+  const Accuracy a = keyframe_accuracy(d, store);
   std::printf("%zu keyframes, %zu loops accepted (%zu without a solve): ATE odometry %.2f m, corrected %.2f m\n",
-              frames.size(), closure.accepted_loops(), closure.solves_skipped(), ate_odometry, ate_corrected);
-  ASSERT_GT(ate_odometry, 2.0);  // the drift is real
+              d.frames.size(), closure.accepted_loops(), closure.solves_skipped(), a.ate_odometry,
+              a.ate_corrected);
+  ASSERT_GT(a.ate_odometry, 2.0);  // the drift is real
   EXPECT_GE(closure.accepted_loops(), 5u);
-  EXPECT_LE(ate_corrected, 0.6 * ate_odometry);
+  EXPECT_LE(a.ate_corrected, 0.6 * a.ate_odometry);
   // No accepted loop joins places that are truly apart.
   for (const auto& row : closure.log().rows()) {
     if (row.verdict != LoopVerdict::kAccepted) continue;
-    EXPECT_LT((gt[row.current_frame].translation() - gt[row.loop_frame].translation()).norm(), 10.0);
+    EXPECT_LT((d.gt[row.current_frame].translation() - d.gt[row.loop_frame].translation()).norm(), 10.0);
   }
+
+  // Window solves during the run end as well as whole-graph solves after every loop.
+  SlamConfig whole = config;
+  whole.pose_graph.solve_window_margin_keyframes = -1;
+  KeyframeStore whole_store;
+  LoopClosure whole_closure(whole, LoopRegistrationMethod::kFeatures, whole_store);
+  close_loops(d, whole, /*backlog=*/false, whole_store, whole_closure);
+  EXPECT_EQ(whole_closure.window_solves(), 0u);
+  const Accuracy w = keyframe_accuracy(d, whole_store);
+  std::printf("whole-graph solves: ATE corrected %.3f m; window solves %.3f m\n", w.ate_corrected,
+              a.ate_corrected);
+  EXPECT_LE(a.ate_corrected, w.ate_corrected + 0.05);
+}
+
+// Behind a backlog the closure stage solves once per pipeline.max_deferred_loops + 1 loops that
+// need a solve, not per loop, and still corrects the drift.
+TEST(LoopClosure, SolvesABacklogsLoopsTogetherAndStillCorrectsTheDrift) {
+  SlamConfig config;
+  config.pipeline.max_deferred_loops = 4;
+  const Drive& d = drifting_drive();
+  KeyframeStore store;
+  LoopClosure closure(config, LoopRegistrationMethod::kFeatures, store);
+  close_loops(d, config, /*backlog=*/true, store, closure);
+
+  const std::size_t needing_solve = closure.accepted_loops() - closure.solves_skipped();
+  const std::size_t solves = closure.optimization_ms().size();
+  std::printf("%zu loops accepted, %zu needed a solve, %zu deferred, %zu solves\n",
+              closure.accepted_loops(), needing_solve, closure.solves_deferred(), solves);
+  ASSERT_GE(needing_solve, 5u);  // enough for a wait to happen
+  EXPECT_GT(closure.solves_deferred(), 0u);
+  // Each solve ends a run of at most 4 deferred loops plus the one that triggered it; the
+  // run's end adds at most one.
+  EXPECT_LE(solves, (needing_solve + 4) / 5 + 1);
+  EXPECT_LT(solves, needing_solve);
+  const PoseGraph& graph = closure.graph();
+  for (std::size_t e = 0; e < graph.edges().size(); ++e)
+    if (graph.edges()[e].is_loop && graph.edges()[e].active) {
+      EXPECT_LT(graph.edge_chi2(e), config.pose_graph.loop_outlier_chi2) << e;
+    }
+  const Accuracy a = keyframe_accuracy(d, store);
+  std::printf("ATE odometry %.2f m, corrected %.2f m\n", a.ate_odometry, a.ate_corrected);
+  EXPECT_LE(a.ate_corrected, 0.6 * a.ate_odometry);
+}
+
+// With accurate odometry most loops agree with the graph as it stands: they join it without a
+// solve (pose_graph.skip_solve_loop_chi2), and the end's one solve leaves every one fitting.
+TEST(LoopClosure, AddsLoopsTheGraphAgreesWithWithoutASolve) {
+  const SlamConfig config;
+  const Drive& d = accurate_drive();
+  KeyframeStore store;
+  LoopClosure closure(config, LoopRegistrationMethod::kFeatures, store);
+  close_loops(d, config, /*backlog=*/false, store, closure);
+  std::printf("%zu loops accepted, %zu without a solve, %zu solves\n", closure.accepted_loops(),
+              closure.solves_skipped(), closure.optimization_ms().size());
+  ASSERT_GE(closure.accepted_loops(), 5u);
+  EXPECT_GT(closure.solves_skipped(), 0u);
+  EXPECT_LT(closure.optimization_ms().size(), closure.accepted_loops());
+  const PoseGraph& graph = closure.graph();
+  for (std::size_t e = 0; e < graph.edges().size(); ++e)
+    if (graph.edges()[e].is_loop && graph.edges()[e].active) {
+      EXPECT_LT(graph.edge_chi2(e), config.pose_graph.loop_outlier_chi2) << e;
+    }
+  const Accuracy a = keyframe_accuracy(d, store);
+  EXPECT_LE(a.ate_corrected, a.ate_odometry + 0.05);  // the solve does no harm
 }

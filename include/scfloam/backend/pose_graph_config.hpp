@@ -24,6 +24,13 @@ struct PoseGraphConfig {
   // long run (docs/robustness-long-run.md). The run ends with one solve if loops were added
   // since the last. 0 = solve after every loop.
   double skip_solve_loop_chi2 = 0.05;
+  // A solve during the run frees only the nodes from the earliest loop partner since the last
+  // solve, minus this many keyframes, to the newest; older nodes stay where they are (they
+  // anchor the window through the edges that reach into it). On a route that keeps revisiting
+  // the same block the loops then cost one lap's keyframes, not the whole history's. The run
+  // ends with a whole-graph solve, so offline results see every loop. < 0: every solve frees
+  // the whole graph.
+  int solve_window_margin_keyframes = 100;
   int max_iterations = 50;
 };
 

@@ -69,6 +69,7 @@ struct RunResult {
   // Loop modes only: every loop candidate with its verdict, the final graph.
   std::vector<LoopCandidate> loop_rows;
   std::size_t loop_solves_skipped = 0;  // accepted loops the graph already agreed with
+  std::size_t loop_solves_deferred = 0;  // accepted loops solved later, with a backlog's others
   std::shared_ptr<const PoseGraph> graph;
   PoseList keyframe_poses;  // final pose of every keyframe
   KeyframeStorageStats keyframe_storage;
