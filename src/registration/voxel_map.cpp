@@ -11,7 +11,7 @@ VoxelMap::VoxelMap(double max_query_radius_m, double min_spacing_m, int max_poin
       inv_cell_size_(static_cast<float>(1.0 / max_query_radius_m)),
       min_spacing_sq_(static_cast<float>(min_spacing_m * min_spacing_m)),
       max_per_cell_(static_cast<std::uint32_t>(max_points_per_cell)),
-      stride_((static_cast<std::uint32_t>(std::max(max_points_per_cell, 1)) + 7u) & ~7u) {
+      stride_(static_cast<std::uint32_t>(std::max(max_points_per_cell, 1))) {
   if (!(max_query_radius_m > 0)) throw Error("voxel map: query radius must be positive");
   if (max_points_per_cell < 1) throw Error("voxel map: max_points_per_cell must be >= 1");
   index_.reset(1024);
@@ -32,18 +32,16 @@ std::size_t VoxelMap::insert(const FeatureCloud& points_lidar,
     }
     Cell& cl = cells_[cell];
     if (cl.count >= max_per_cell_) continue;
-    float* xs = cell_xyz(cell);
-    float* ys = xs + stride_;
-    float* zs = ys + stride_;
+    float* xyz = cell_xyz(cell);
     bool too_close = false;
     for (std::uint32_t i = 0; i < cl.count && !too_close; ++i) {
-      const float dx = xs[i] - p.x(), dy = ys[i] - p.y(), dz = zs[i] - p.z();
+      const float dx = xyz[3 * i] - p.x(), dy = xyz[3 * i + 1] - p.y(), dz = xyz[3 * i + 2] - p.z();
       too_close = dx * dx + dy * dy + dz * dz < min_spacing_sq_;
     }
     if (too_close) continue;
-    xs[cl.count] = p.x();
-    ys[cl.count] = p.y();
-    zs[cl.count] = p.z();
+    xyz[3 * cl.count] = p.x();
+    xyz[3 * cl.count + 1] = p.y();
+    xyz[3 * cl.count + 2] = p.z();
     ++cl.count;
     ++num_points_;
     ++stored;
@@ -59,55 +57,48 @@ void VoxelMap::knn(const Eigen::Vector3f& q, int k, float radius_m, Neighbors& o
   const Eigen::Vector3f s = q * inv_cell_size_;
   const Eigen::Vector3i c(static_cast<int>(std::floor(s.x())), static_cast<int>(std::floor(s.y())),
                           static_cast<int>(std::floor(s.z())));
-  // Squared distance from q to the lower / upper face of its cell, per axis.
-  float lo2[3], hi2[3];
+  // Squared distance from q to the lower / upper face of its cell, per axis: face2[a][0] for
+  // offset -1, [1] = 0 for its own slab, [2] for +1. A neighbour's box distance is then three
+  // table reads (this loop runs 27 times per query, the hottest part of the search).
+  float face2[3][3];
   for (int a = 0; a < 3; ++a) {
     const float f = (s[a] - c[a]) * cell_size_;
-    lo2[a] = f * f;
-    hi2[a] = (cell_size_ - f) * (cell_size_ - f);
+    face2[a][0] = f * f;
+    face2[a][1] = 0.f;
+    face2[a][2] = (cell_size_ - f) * (cell_size_ - f);
   }
   // Cells are `radius` wide, so the ball lies in the 27 around q's cell. Visit q's own cell,
   // then faces, edges and corners; skip a cell whose box is farther than the current k-th
-  // neighbour (or the radius): most queries read only two or three cells.
+  // neighbour (or the radius): most queries read only five or six cells.
   static constexpr int kOrder[27][3] = {
       {0, 0, 0},   {-1, 0, 0},  {1, 0, 0},   {0, -1, 0},  {0, 1, 0},   {0, 0, -1}, {0, 0, 1},
       {-1, -1, 0}, {-1, 1, 0},  {1, -1, 0},  {1, 1, 0},   {-1, 0, -1}, {-1, 0, 1}, {1, 0, -1},
       {1, 0, 1},   {0, -1, -1}, {0, -1, 1},  {0, 1, -1},  {0, 1, 1},   {-1, -1, -1},
       {-1, -1, 1}, {-1, 1, -1}, {-1, 1, 1},  {1, -1, -1}, {1, -1, 1},  {1, 1, -1}, {1, 1, 1}};
-  // Squared distances of a block of a cell's points, computed together (vectorizes), then
-  // merged into the sorted best k; `bound` is the k-th distance once k are found, else r^2.
-  constexpr std::uint32_t kBlock = 32;
-  float d2[kBlock];
+  // `bound` is the k-th distance once k are found, else r^2; each closer point is merged into
+  // the sorted best k.
+  const float qx = q.x(), qy = q.y(), qz = q.z();
   float bound = r2;
   for (const auto& o : kOrder) {
-    float box2 = 0;
-    for (int a = 0; a < 3; ++a) box2 += o[a] < 0 ? lo2[a] : (o[a] > 0 ? hi2[a] : 0.f);
+    const float box2 = face2[0][o[0] + 1] + face2[1][o[1] + 1] + face2[2][o[2] + 1];
     if (box2 >= bound) continue;
     const std::uint32_t cell = index_.find(voxel_key(c.x() + o[0], c.y() + o[1], c.z() + o[2]));
     if (cell == FlatKeyIndex::kNone) continue;
-    const float* xs = cell_xyz(cell);
-    const float* ys = xs + stride_;
-    const float* zs = ys + stride_;
+    const float* xyz = cell_xyz(cell);
     const std::uint32_t n = cells_[cell].count;
-    for (std::uint32_t b = 0; b < n; b += kBlock) {
-      const std::uint32_t m = std::min(kBlock, n - b);
-      for (std::uint32_t i = 0; i < m; ++i) {
-        const float dx = xs[b + i] - q.x(), dy = ys[b + i] - q.y(), dz = zs[b + i] - q.z();
-        d2[i] = dx * dx + dy * dy + dz * dz;
+    for (std::uint32_t i = 0; i < n; ++i, xyz += 3) {
+      const float dx = xyz[0] - qx, dy = xyz[1] - qy, dz = xyz[2] - qz;
+      const float d = dx * dx + dy * dy + dz * dz;
+      if (d >= bound) continue;
+      int j = out.count < k ? out.count++ : k - 1;  // insertion sort into the best k
+      while (j > 0 && out.sq_dist[j - 1] > d) {
+        out.sq_dist[j] = out.sq_dist[j - 1];
+        out.points[j] = out.points[j - 1];
+        --j;
       }
-      for (std::uint32_t i = 0; i < m; ++i) {
-        const float d = d2[i];
-        if (d >= bound) continue;
-        int j = out.count < k ? out.count++ : k - 1;  // insertion sort into the best k
-        while (j > 0 && out.sq_dist[j - 1] > d) {
-          out.sq_dist[j] = out.sq_dist[j - 1];
-          out.points[j] = out.points[j - 1];
-          --j;
-        }
-        out.sq_dist[j] = d;
-        out.points[j] = Eigen::Vector3f(xs[b + i], ys[b + i], zs[b + i]);
-        if (out.count == k) bound = out.sq_dist[k - 1];
-      }
+      out.sq_dist[j] = d;
+      out.points[j] = Eigen::Vector3f(xyz[0], xyz[1], xyz[2]);
+      if (out.count == k) bound = out.sq_dist[k - 1];
     }
   }
 }
@@ -148,9 +139,9 @@ FeatureCloud VoxelMap::points() const {
   FeatureCloud out;
   out.reserve(num_points_);
   for (std::size_t i = 0; i < cells_.size(); ++i) {
-    const float* xs = cell_xyz(i);
+    const float* xyz = cell_xyz(i);
     for (std::uint32_t j = 0; j < cells_[i].count; ++j)
-      out.emplace_back(xs[j], xs[stride_ + j], xs[2 * stride_ + j]);
+      out.emplace_back(xyz[3 * j], xyz[3 * j + 1], xyz[3 * j + 2]);
   }
   return out;
 }

@@ -50,14 +50,15 @@ class VoxelMap {
     std::uint32_t count = 0;
   };
 
-  // Cell c's coordinates live at pool_[c * 3 * stride_]: x[stride_], y[stride_], z[stride_]
-  // (structure of arrays, so the distance loop of knn runs on SIMD lanes).
+  // Cell c's points live at pool_[c * 3 * stride_], x y z after each other. Interleaved, not a
+  // structure of arrays: a query reads ~5 cells of ~5 points each, and the search waits on
+  // memory, so one or two cache lines per cell beat three (measured, docs/odometry.md).
   float* cell_xyz(std::size_t cell) { return &pool_[cell * 3 * stride_]; }
   const float* cell_xyz(std::size_t cell) const { return &pool_[cell * 3 * stride_]; }
 
   float cell_size_, inv_cell_size_, min_spacing_sq_;
   std::uint32_t max_per_cell_;
-  std::uint32_t stride_;  // max_per_cell_ rounded up to a multiple of 8
+  std::uint32_t stride_;  // points a cell has room for (max_per_cell_)
   FlatKeyIndex index_;
   std::vector<Cell> cells_;
   std::vector<float> pool_;  // 3 * stride_ floats per cell
