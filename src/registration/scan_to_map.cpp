@@ -167,32 +167,59 @@ namespace {
 using Matrix6 = Eigen::Matrix<double, 6, 6>;
 using Basis6 = Eigen::Matrix<double, 6, Eigen::Dynamic>;
 
-// Gauss-Newton Hessian J^T J (tangent [omega; v]) of the matches at T, robustified when
-// huber_delta_m > 0, and the sum of their point-to-line/plane distances before the loss.
-// Unrobustified, it measures the geometry alone: how many matches constrain each direction,
-// whatever their current residual (far from the solution the loss would hide a good wall).
-Matrix6 hessian_of(const std::vector<EdgeMatch>& edges, const std::vector<PlaneMatch>& planes,
-                   const Eigen::Isometry3d& T, double huber_delta_m, double* sum_dist) {
+// Gauss-Newton Hessians J^T J (tangent [omega; v]) of the matches at T: `plain` unrobustified,
+// which measures the geometry alone (how many matches constrain each direction, whatever their
+// current residual: far from the solution the loss would hide a good wall), and, when
+// huber_delta_m > 0, `robust` with the loss; plus the sum of point-to-line/plane distances.
+// Fixed blocks summed in block order: the same sums whatever the threads.
+struct Hessians {
+  Matrix6 plain = Matrix6::Zero(), robust = Matrix6::Zero();
+  double sum_dist = 0;
+};
+
+Hessians hessians_of(const std::vector<EdgeMatch>& edges, const std::vector<PlaneMatch>& planes,
+                     const Eigen::Isometry3d& T, double huber_delta_m, tbb::task_arena* arena) {
   const Eigen::Matrix3d R = T.linear();
   const Eigen::Vector3d t = T.translation();
-  Matrix6 H = Matrix6::Zero();
-  double dist = 0;
-  for (const auto& m : edges) {
-    Jacobian36 J;
-    Eigen::Vector3d r = edge_residual(m, R, t, &J);
-    dist += r.norm();
-    if (huber_delta_m > 0) robustify_huber<3>(huber_delta_m, r, &J);
-    H.noalias() += J.transpose() * J;
+  constexpr std::size_t kBlock = 1024;
+  const std::size_t n_edges = edges.size(), total = n_edges + planes.size();
+  const std::size_t n_blocks = (total + kBlock - 1) / kBlock;
+  std::vector<Hessians> blocks(n_blocks);
+  auto run_block = [&](std::size_t b) {
+    Hessians& h = blocks[b];
+    const std::size_t begin = b * kBlock, end = std::min(total, begin + kBlock);
+    for (std::size_t i = begin; i < std::min(end, n_edges); ++i) {
+      Jacobian36 J;
+      Eigen::Vector3d r = edge_residual(edges[i], R, t, &J);
+      h.sum_dist += r.norm();
+      h.plain.noalias() += J.transpose() * J;
+      if (huber_delta_m > 0) {
+        robustify_huber<3>(huber_delta_m, r, &J);
+        h.robust.noalias() += J.transpose() * J;
+      }
+    }
+    for (std::size_t i = std::max(begin, n_edges); i < end; ++i) {
+      Jacobian16 J;
+      Eigen::Matrix<double, 1, 1> r(plane_residual(planes[i - n_edges], R, t, &J));
+      h.sum_dist += std::abs(r[0]);
+      h.plain.noalias() += J.transpose() * J;
+      if (huber_delta_m > 0) {
+        robustify_huber<1>(huber_delta_m, r, &J);
+        h.robust.noalias() += J.transpose() * J;
+      }
+    }
+  };
+  if (arena && n_blocks > 1)
+    arena->execute([&] { tbb::parallel_for(std::size_t{0}, n_blocks, run_block); });
+  else
+    for (std::size_t b = 0; b < n_blocks; ++b) run_block(b);
+  Hessians sum;
+  for (const Hessians& h : blocks) {
+    sum.plain += h.plain;
+    sum.robust += h.robust;
+    sum.sum_dist += h.sum_dist;
   }
-  for (const auto& m : planes) {
-    Jacobian16 J;
-    Eigen::Matrix<double, 1, 1> r(plane_residual(m, R, t, &J));
-    dist += std::abs(r[0]);
-    if (huber_delta_m > 0) robustify_huber<1>(huber_delta_m, r, &J);
-    H.noalias() += J.transpose() * J;
-  }
-  if (sum_dist) *sum_dist = dist;
-  return H;
+  return sum;
 }
 
 // Ends a Ceres solve once an accepted step is smaller than `tolerance` (tangent norm, rad and
@@ -243,7 +270,7 @@ RegistrationResult ScanToMapRegistration::align(const FeatureCloud& edges_lidar,
     std::unique_ptr<SubspacePoseManifold> subspace;
     if (config_.degeneracy_fallback) {
       const Degeneracy cond(
-          hessian_of(edge_out_, plane_out_, block_to_pose(pose), 0.0, nullptr), config_);
+          hessians_of(edge_out_, plane_out_, block_to_pose(pose), 0.0, arena_.get()).plain, config_);
       if (cond.weak() == 6) break;  // nothing is constrained: keep the guess
       if (cond.weak() > 0) subspace = std::make_unique<SubspacePoseManifold>(cond.basis(true));
     }
@@ -286,16 +313,14 @@ RegistrationResult ScanToMapRegistration::align(const FeatureCloud& edges_lidar,
       break;
   }
 
-  // Hessian and residuals of the final matches at the solution.
+  // Hessians and residuals of the final matches at the solution.
   const std::size_t n = edge_out_.size() + plane_out_.size();
-  double sum_dist = 0;
-  result.hessian = n < kMinMatches ? Matrix6::Zero()
-                                   : hessian_of(edge_out_, plane_out_, block_to_pose(pose),
-                                                config_.huber_delta_m, &sum_dist);
-  const Degeneracy cond(
-      n < kMinMatches ? Matrix6::Zero()
-                      : hessian_of(edge_out_, plane_out_, block_to_pose(pose), 0.0, nullptr),
-      config_);
+  const Hessians final_h = n < kMinMatches ? Hessians{}
+                                           : hessians_of(edge_out_, plane_out_, block_to_pose(pose),
+                                                         config_.huber_delta_m, arena_.get());
+  const double sum_dist = final_h.sum_dist;
+  result.hessian = config_.huber_delta_m > 0 ? final_h.robust : final_h.plain;
+  const Degeneracy cond(final_h.plain, config_);
   // Solution remapping: whatever the rounds did along the final weak directions is undone,
   // so the pose there is the initial guess (the motion model); the strong part is kept.
   if (config_.degeneracy_fallback && cond.weak() > 0) {
