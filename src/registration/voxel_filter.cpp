@@ -1,19 +1,21 @@
 #include "scfloam/registration/voxel_filter.hpp"
 
+#include <tbb/parallel_invoke.h>
+
 #include <algorithm>
 
 #include "scfloam/error.hpp"
 
 namespace scfloam {
 
-void VoxelFilter::filter(const FeatureCloud& in, double leaf_m, FeatureCloud& out) {
-  if (!(leaf_m > 0)) throw Error("voxel filter: leaf size must be positive");
-  const float inv = static_cast<float>(1.0 / leaf_m);
+void VoxelFilter::Part::accumulate(const Eigen::Vector3f* begin, const Eigen::Vector3f* end,
+                                   float inv, std::size_t expected_voxels) {
   // Size the table for the voxels of the previous call, not for every input point: a frame's
   // ~100k plane points fill only ~8k voxels, and a table that fits in cache is several times
   // faster to clear and probe (it grows if the guess is short).
-  index_.reset(std::min(in.size(), std::max<std::size_t>(last_voxels_, 1024)) + 16);
-  sums_.clear();
+  index.reset(std::min(static_cast<std::size_t>(end - begin), expected_voxels) + 16);
+  sums.clear();
+  keys.clear();
   // Feature clouds come ring by ring in azimuth order, so a run of consecutive points usually
   // shares a voxel: sum the run in registers and probe the table only when the voxel changes.
   // (Scalar sums: building an Eigen::Vector4f per point from x, y, z, 1 went through the stack
@@ -22,28 +24,58 @@ void VoxelFilter::filter(const FeatureCloud& in, double leaf_m, FeatureCloud& ou
   float sx = 0, sy = 0, sz = 0, count = 0;
   const auto flush = [&]() {
     if (count == 0) return;
-    const Eigen::Vector4f run(sx, sy, sz, count);
-    const std::uint32_t slot = index_.insert(run_key, static_cast<std::uint32_t>(sums_.size()));
-    if (slot == sums_.size()) sums_.push_back(run);
-    else sums_[slot] += run;
+    add(run_key, Eigen::Vector4f(sx, sy, sz, count));
   };
-  for (const auto& p : in) {
-    const Eigen::Vector3i c = voxel_coords(p, inv);
+  for (const Eigen::Vector3f* p = begin; p != end; ++p) {
+    const Eigen::Vector3i c = voxel_coords(*p, inv);
     const std::uint64_t key = voxel_key(c.x(), c.y(), c.z());
     if (key != run_key) {
       flush();
       run_key = key;
       sx = sy = sz = count = 0;
     }
-    sx += p.x();
-    sy += p.y();
-    sz += p.z();
+    sx += p->x();
+    sy += p->y();
+    sz += p->z();
     count += 1;
   }
   flush();
-  last_voxels_ = sums_.size();
-  out.resize(sums_.size());
-  for (std::size_t i = 0; i < sums_.size(); ++i) out[i] = sums_[i].head<3>() / sums_[i].w();
+}
+
+void VoxelFilter::Part::add(std::uint64_t key, const Eigen::Vector4f& sum) {
+  const std::uint32_t slot = index.insert(key, static_cast<std::uint32_t>(sums.size()));
+  if (slot == sums.size()) {
+    sums.push_back(sum);
+    keys.push_back(key);
+  } else {
+    sums[slot] += sum;
+  }
+}
+
+void VoxelFilter::filter(const FeatureCloud& in, double leaf_m, FeatureCloud& out) {
+  if (!(leaf_m > 0)) throw Error("voxel filter: leaf size must be positive");
+  const float inv = static_cast<float>(1.0 / leaf_m);
+  const std::size_t expected = std::max<std::size_t>(last_voxels_, 1024);
+  const Eigen::Vector3f* p = in.data();
+  const std::size_t n = in.size();
+  // Large clouds (a frame's ~100k plane points) in two halves on two threads; the second
+  // half's voxels are then merged into the first's. A voxel first seen in the first half keeps
+  // that place and the second half's new voxels follow in their order, so the output is in
+  // first-seen order as from one pass; only the sums' association differs. The split is
+  // fixed, so the result does not depend on the scheduling.
+  constexpr std::size_t kParallelMin = 32768;
+  if (n < kParallelMin) {
+    first_.accumulate(p, p + n, inv, expected);
+  } else {
+    const std::size_t half = n / 2;
+    tbb::parallel_invoke([&] { first_.accumulate(p, p + half, inv, expected); },
+                         [&] { second_.accumulate(p + half, p + n, inv, expected); });
+    for (std::size_t i = 0; i < second_.sums.size(); ++i) first_.add(second_.keys[i], second_.sums[i]);
+  }
+  const std::vector<Eigen::Vector4f>& sums = first_.sums;
+  last_voxels_ = sums.size();
+  out.resize(sums.size());
+  for (std::size_t i = 0; i < sums.size(); ++i) out[i] = sums[i].head<3>() / sums[i].w();
 }
 
 FeatureCloud voxel_downsample(const FeatureCloud& in, double leaf_m) {

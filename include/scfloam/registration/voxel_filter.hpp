@@ -11,13 +11,22 @@ namespace scfloam {
 class VoxelFilter {
  public:
   // Replaces `out` with the centroids of `in`'s points per leaf_m voxel, in first-seen order.
-  // Buffers are kept between calls, so steady-state use allocates nothing.
+  // Buffers are kept between calls, so steady-state use allocates nothing. Large clouds are
+  // summed in two halves in parallel (TBB).
   void filter(const FeatureCloud& in, double leaf_m, FeatureCloud& out);
 
  private:
-  FlatKeyIndex index_;
-  std::vector<Eigen::Vector4f> sums_;  // xyz sum, count
-  std::size_t last_voxels_ = 0;        // voxels of the previous call: sizes the table
+  // Per-voxel sums of one run of points.
+  struct Part {
+    FlatKeyIndex index;                 // voxel key -> position in sums
+    std::vector<Eigen::Vector4f> sums;  // xyz sum, count; in first-seen order
+    std::vector<std::uint64_t> keys;    // the voxel of each sum
+    void accumulate(const Eigen::Vector3f* begin, const Eigen::Vector3f* end, float inv,
+                    std::size_t expected_voxels);
+    void add(std::uint64_t key, const Eigen::Vector4f& sum);
+  };
+  Part first_, second_;
+  std::size_t last_voxels_ = 0;  // voxels of the previous call: sizes the tables
 };
 
 // Convenience for one-off use (submaps, tests).
