@@ -30,7 +30,8 @@ function(scfloam_test_suite room)
   if(NOT sources)
     return()
   endif()
-  add_executable(test_${room} ${sources})
+  # tests/support/tbb_threads.cpp: SCFLOAM_TBB_THREADS caps TBB's threads (scripts/tsan.sh).
+  add_executable(test_${room} ${sources} ${CMAKE_SOURCE_DIR}/tests/support/tbb_threads.cpp)
   target_link_libraries(test_${room} PRIVATE ${T_LIBS} GTest::gtest GTest::gtest_main)
   target_include_directories(test_${room} PRIVATE ${CMAKE_SOURCE_DIR}/src ${CMAKE_SOURCE_DIR}/tests)
   target_compile_definitions(test_${room} PRIVATE
