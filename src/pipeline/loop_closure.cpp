@@ -100,17 +100,18 @@ bool LoopClosure::add(const KeyframePtr& keyframe, const LoopQuery& detected, bo
   graph_.add_loop_edge(k, loop_kf, match.T_loop_current.inverse(), config_.pose_graph);
   loop_rows_.push_back(*row);
   earliest_partner_ = std::min(earliest_partner_, loop_kf);
-  if (graph_.edge_chi2(graph_.edges().size() - 1) < config_.pose_graph.skip_solve_loop_chi2) {
-    // Already consistent: the edge joins the graph for the next solve; the poses stand.
-    ++solves_skipped_;
-    unsolved_loops_ = true;
-    accepted_ = graph_.loop_edge_count();
-    return true;
-  }
-  const int max_deferred = config_.pipeline.max_deferred_loops;
-  if (backlog && pending_deferred_ < static_cast<std::size_t>(std::max(max_deferred, 0))) {
+  // A loop the graph already agrees with joins it for the next solve, the poses standing; one
+  // that arrives while keyframes wait for this stage waits for the backlog's solve.
+  const bool agrees =
+      graph_.edge_chi2(graph_.edges().size() - 1) < config_.pose_graph.skip_solve_loop_chi2;
+  const auto max_deferred = static_cast<std::size_t>(std::max(config_.pipeline.max_deferred_loops, 0));
+  const bool defer = !agrees && backlog && pending_deferred_ < max_deferred;
+  solves_skipped_ += agrees;
+  if (defer) {
     ++pending_deferred_;
     ++solves_deferred_;
+  }
+  if (agrees || defer) {
     unsolved_loops_ = true;
     accepted_ = graph_.loop_edge_count();
     return true;

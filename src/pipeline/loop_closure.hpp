@@ -42,7 +42,7 @@ class LoopClosure {
   const std::vector<double>& optimization_ms() const { return optimization_ms_; }
   // Accepted loops added without a solve (pose_graph.skip_solve_loop_chi2).
   std::size_t solves_skipped() const { return solves_skipped_; }
-  // Accepted loops whose solve waited for a backlog to clear, and the solves that ended a wait.
+  // Accepted loops whose solve waited for a backlog to clear (pipeline.max_deferred_loops).
   std::size_t solves_deferred() const { return solves_deferred_; }
   // Solves that freed only a window of the graph (pose_graph.solve_window_margin_keyframes).
   std::size_t window_solves() const { return window_solves_; }

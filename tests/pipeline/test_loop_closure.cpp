@@ -110,6 +110,14 @@ Accuracy keyframe_accuracy(const Drive& d, const KeyframeStore& store) {
   return {ate_rmse_m(gt_kf, odom_kf), ate_rmse_m(gt_kf, store.current_poses())};
 }
 
+// Every active loop edge, solved with or without its own solve, fits the final graph.
+void expect_active_loops_fit(const PoseGraph& graph, const SlamConfig& config) {
+  for (std::size_t e = 0; e < graph.edges().size(); ++e)
+    if (graph.edges()[e].is_loop && graph.edges()[e].active) {
+      EXPECT_LT(graph.edge_chi2(e), config.pose_graph.loop_outlier_chi2) << e;
+    }
+}
+
 }  // namespace
 
 TEST(LoopClosure, CorrectsADriftingOdometryOnASimulatedDrive) {
@@ -121,12 +129,7 @@ TEST(LoopClosure, CorrectsADriftingOdometryOnASimulatedDrive) {
 
   EXPECT_EQ(closure.solves_deferred(), 0u);  // no backlog, no waiting
   EXPECT_GT(closure.window_solves(), 0u);    // later loops solved a window of the graph
-  // Every active loop edge, solved or not, fits the final graph.
-  const PoseGraph& graph = closure.graph();
-  for (std::size_t e = 0; e < graph.edges().size(); ++e)
-    if (graph.edges()[e].is_loop && graph.edges()[e].active) {
-      EXPECT_LT(graph.edge_chi2(e), config.pose_graph.loop_outlier_chi2) << e;
-    }
+  expect_active_loops_fit(closure.graph(), config);
 
   const Accuracy a = keyframe_accuracy(d, store);
   std::printf("%zu keyframes, %zu loops accepted (%zu without a solve): ATE odometry %.2f m, corrected %.2f m\n",
@@ -174,11 +177,7 @@ TEST(LoopClosure, SolvesABacklogsLoopsTogetherAndStillCorrectsTheDrift) {
   // run's end adds at most one.
   EXPECT_LE(solves, (needing_solve + 4) / 5 + 1);
   EXPECT_LT(solves, needing_solve);
-  const PoseGraph& graph = closure.graph();
-  for (std::size_t e = 0; e < graph.edges().size(); ++e)
-    if (graph.edges()[e].is_loop && graph.edges()[e].active) {
-      EXPECT_LT(graph.edge_chi2(e), config.pose_graph.loop_outlier_chi2) << e;
-    }
+  expect_active_loops_fit(closure.graph(), config);
   const Accuracy a = keyframe_accuracy(d, store);
   std::printf("ATE odometry %.2f m, corrected %.2f m\n", a.ate_odometry, a.ate_corrected);
   EXPECT_LE(a.ate_corrected, 0.6 * a.ate_odometry);
@@ -197,11 +196,7 @@ TEST(LoopClosure, AddsLoopsTheGraphAgreesWithWithoutASolve) {
   ASSERT_GE(closure.accepted_loops(), 5u);
   EXPECT_GT(closure.solves_skipped(), 0u);
   EXPECT_LT(closure.optimization_ms().size(), closure.accepted_loops());
-  const PoseGraph& graph = closure.graph();
-  for (std::size_t e = 0; e < graph.edges().size(); ++e)
-    if (graph.edges()[e].is_loop && graph.edges()[e].active) {
-      EXPECT_LT(graph.edge_chi2(e), config.pose_graph.loop_outlier_chi2) << e;
-    }
+  expect_active_loops_fit(closure.graph(), config);
   const Accuracy a = keyframe_accuracy(d, store);
   EXPECT_LE(a.ate_corrected, a.ate_odometry + 0.05);  // the solve does no harm
 }
