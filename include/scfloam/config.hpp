@@ -39,6 +39,10 @@ struct FeatureConfig {
   int sectors_per_ring = 6;
   int max_edges_per_sector = 20;
   double edge_min_curvature = 0.1;   // squared-norm curvature, F-LOAM's unit (m^2)
+  // An edge's curvature must also exceed this x the median curvature of its ring (0 = off).
+  // Most of a ring lies on smooth surfaces, so the median measures the curvature that range
+  // noise alone makes there; with 2 cm noise, near ground reaches 0.1 on one point in ten.
+  double edge_noise_factor = 40.0;
   double suppression_gap_m = 0.2236; // neighbours of an edge are suppressed while closer than this
   // LOAM's occlusion test: at a depth jump between neighbours at nearly the same bearing
   // (gap / range < occlusion_gap_ratio), the far side's points are hidden or revealed as the
@@ -86,7 +90,7 @@ struct RegistrationConfig {
   // Relative test (registration/degeneracy.hpp): an eigenvalue of the translation (rotation)
   // block below this fraction of the block's largest is weak. Measured: simulated city and
   // KITTI-05-like >= 0.27 and >= 0.15; inside the tunnel 0.17-0.2 and 0.017-0.05.
-  double degeneracy_min_translation_ratio = 0.2;
+  double degeneracy_min_translation_ratio = 0.1;
   double degeneracy_min_rotation_ratio = 0.05;
   // Odometry: the second frame's prediction is a guess (zero velocity), so a coarse pass first
   // aligns it to the first frame's features with this search radius, wider than

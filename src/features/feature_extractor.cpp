@@ -47,12 +47,25 @@ void correct_elevation(FeatureCloud& points, double angle_deg) {
 void ring_curvature(const Eigen::Vector3f* p, int n, int hw, float* curvature) {
   std::fill(curvature, curvature + n, 0.f);
   if (n < 2 * hw + 1) return;
-  // Sliding window sum in double: float prefix sums lose centimetres at 90 m ranges.
-  Eigen::Vector3d window = Eigen::Vector3d::Zero();
-  for (int j = 0; j < 2 * hw + 1; ++j) window += p[j].cast<double>();
+  // Sliding sums of the hw points before and after i, in double: float prefix sums lose
+  // centimetres at 90 m ranges.
+  Eigen::Vector3d left = Eigen::Vector3d::Zero(), right = Eigen::Vector3d::Zero();
+  for (int j = 0; j < hw; ++j) left += p[j].cast<double>();
+  for (int j = hw + 1; j <= 2 * hw; ++j) right += p[j].cast<double>();
   for (int i = hw; i < n - hw; ++i) {
-    if (i > hw) window += p[i + hw].cast<double>() - p[i - hw - 1].cast<double>();
-    const Eigen::Vector3d d = window - (2 * hw + 1) * p[i].cast<double>();
+    if (i > hw) {
+      left += p[i - 1].cast<double>() - p[i - hw - 1].cast<double>();
+      right += p[i + hw].cast<double>() - p[i].cast<double>();
+    }
+    const Eigen::Vector3d pi = p[i].cast<double>();
+    Eigen::Vector3d d = left + right - (2 * hw) * pi;
+    // Only the part across the chord from the left to the right neighbours counts. Along the
+    // chord, d measures uneven spacing, not shape: a dropped return on smooth ground shifts
+    // one side's mean by a spacing, which at 30 m passes the edge threshold, and those
+    // ring-bound "edges" pull the pose back to the last frame's (docs/degenerate.md).
+    const Eigen::Vector3d chord = right - left;
+    const double c2 = chord.squaredNorm();
+    if (c2 > 0) d -= (d.dot(chord) / c2) * chord;
     curvature[i] = static_cast<float>(d.squaredNorm());
   }
 }
@@ -69,6 +82,7 @@ FeatureExtractor::FeatureExtractor(const PreprocessConfig& preprocess, const Rin
   ring_begin_.resize(beams_ + 1);
   candidates_.resize(beams_);
   ring_edges_.resize(beams_);
+  noise_scratch_.resize(beams_);
   ring_planes_.resize(beams_);
   ring_resorted_.resize(beams_);
   sort_scratch_.resize(beams_);
@@ -184,7 +198,15 @@ void FeatureExtractor::select_in_ring(int ring) {
       }
     }
   }
-  const float threshold = static_cast<float>(feat_.edge_min_curvature);
+  float threshold = static_cast<float>(feat_.edge_min_curvature);
+  if (feat_.edge_noise_factor > 0) {
+    // The median of every 4th point: as good an estimate of the noise level, 4x cheaper.
+    std::vector<float>& sorted = noise_scratch_[ring];
+    sorted.clear();
+    for (int i = hw; i < n - hw; i += 4) sorted.push_back(curv[i]);
+    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+    threshold = std::max(threshold, static_cast<float>(feat_.edge_noise_factor) * sorted[sorted.size() / 2]);
+  }
   const float gap2 = static_cast<float>(feat_.suppression_gap_m * feat_.suppression_gap_m);
   const int sectors = feat_.sectors_per_ring;
   const int usable = n - 2 * hw;

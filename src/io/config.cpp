@@ -40,6 +40,7 @@ std::vector<Binding> bindings(SlamConfig& c) {
       {feat, "sectors_per_ring", &o.features.sectors_per_ring},
       {feat, "max_edges_per_sector", &o.features.max_edges_per_sector},
       {feat, "edge_min_curvature", &o.features.edge_min_curvature},
+      {feat, "edge_noise_factor", &o.features.edge_noise_factor},
       {feat, "suppression_gap_m", &o.features.suppression_gap_m},
       {feat, "reject_occluded", &o.features.reject_occluded},
       {feat, "occlusion_gap_ratio", &o.features.occlusion_gap_ratio},

@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <random>
 
 #include "scfloam/features/deskew.hpp"
 #include "scfloam/features/feature_extractor.hpp"
@@ -24,6 +26,30 @@ TEST(Curvature, ZeroOnALineLargeAtACorner) {
   EXPECT_EQ(c_line[0], 0.f);  // ends without a full window
 }
 
+// Uneven spacing is not shape: a line with a dropped sample stays at zero curvature (F-LOAM's
+// plain sum would give the gap's shift, here (0.1 x 4)^2 = 0.16 m^2 next to it, above its 0.1
+// edge threshold), while a corner with a dropped sample still reads as a corner.
+TEST(Curvature, ADroppedSampleOnALineIsNotCurvature) {
+  std::vector<Eigen::Vector3f> line, corner;
+  for (int i = 0; i < 22; ++i) {
+    if (i == 12) continue;  // the dropped return
+    line.emplace_back(0.1f * i, 30.f, -1.7f);
+    corner.emplace_back(i <= 10 ? 0.1f * i : 1.f, i <= 10 ? 0.f : 0.1f * (i - 10), 0.f);
+  }
+  std::vector<float> c_line(21), c_corner(21);
+  ring_curvature(line.data(), 21, 5, c_line.data());
+  ring_curvature(corner.data(), 21, 5, c_corner.data());
+  for (int i = 5; i < 16; ++i) EXPECT_NEAR(c_line[i], 0.f, 1e-5f) << i;
+  EXPECT_GT(c_corner[10], 2.f);
+}
+
+LidarPoint ring_point(const Eigen::Vector3d& p, int ring) {
+  LidarPoint lp;
+  lp.x = float(p.x()), lp.y = float(p.y()), lp.z = float(p.z());
+  lp.ring = static_cast<std::int16_t>(ring);
+  return lp;
+}
+
 // A 64-beam scan of a room corner seen from inside: two walls meeting at a vertical edge.
 std::vector<LidarPoint> corner_room_scan() {
   std::vector<LidarPoint> pts;
@@ -39,11 +65,7 @@ std::vector<LidarPoint> corner_room_scan() {
       if (dir.y() > 1e-9) t = std::min(t, 10.0 / dir.y());
       if (dir.x() < -1e-9) t = std::min(t, -20.0 / dir.x());
       if (dir.y() < -1e-9) t = std::min(t, -20.0 / dir.y());
-      const Eigen::Vector3d p = t * dir;
-      LidarPoint lp;
-      lp.x = float(p.x()), lp.y = float(p.y()), lp.z = float(p.z());
-      lp.ring = static_cast<std::int16_t>(ring);
-      pts.push_back(lp);
+      pts.push_back(ring_point(t * dir, ring));
     }
   }
   return pts;
@@ -104,6 +126,61 @@ TEST(FeatureExtractor, ElevationCorrectionRotatesTheSelectedFeaturesUp) {
     const Eigen::Vector3d a = e0[i].cast<double>(), b = e1[i].cast<double>();
     EXPECT_NEAR(std::atan2(b.z(), b.head<2>().norm()) - std::atan2(a.z(), a.head<2>().norm()), angle, 1e-5);
   }
+}
+
+// Flat ground all around, seen with 2 cm range noise, and one vertical corner of two walls
+// (x = 12 and y = 12, first quadrant) standing on it.
+std::vector<LidarPoint> noisy_ground_and_corner_scan() {
+  std::mt19937 rng(7);
+  std::normal_distribution<double> noise(0.0, 0.02);
+  std::vector<LidarPoint> pts;
+  for (int ring = 0; ring < 64; ++ring) {
+    const double elev = (ring <= 31 ? 2.0 - ring / 3.0 : -8.87 - (ring - 32) * 0.52) * M_PI / 180.0;
+    for (int col = 0; col < 2000; ++col) {
+      const double az = col * 2 * M_PI / 2000;
+      const Eigen::Vector3d dir(std::cos(elev) * std::cos(az), std::cos(elev) * std::sin(az), std::sin(elev));
+      double t = dir.z() < -1e-9 ? -1.73 / dir.z() : 1e9;  // the ground, 1.73 m below
+      if (dir.x() > 1e-9 && dir.y() > 0) {
+        const double tw = 12.0 / dir.x();
+        if (tw * dir.y() <= 12.0) t = std::min(t, tw);
+      }
+      if (dir.y() > 1e-9 && dir.x() > 0) {
+        const double tw = 12.0 / dir.y();
+        if (tw * dir.x() <= 12.0) t = std::min(t, tw);
+      }
+      if (t > 80) continue;  // no return
+      pts.push_back(ring_point((t + noise(rng)) * dir, ring));
+    }
+  }
+  return pts;
+}
+
+// Range noise alone makes F-LOAM's curvature pass 0.1 on about one near ground point in ten;
+// those "edges" follow the rings, so they move with the sensor. The ring-median noise floor
+// (edge_noise_factor) removes them and keeps the corner.
+TEST(FeatureExtractor, RangeNoiseOnFlatGroundMakesNoEdgesButTheCornerStays) {
+  auto count = [](double factor, std::size_t* ground, std::size_t* at_corner) {
+    OdometryConfig c;
+    c.preprocess.elevation_correction_deg = 0;
+    c.features.edge_noise_factor = factor;
+    FeatureExtractor extractor(c.preprocess, c.rings, c.features);
+    FeatureCloud edges, planes;
+    extractor.extract(noisy_ground_and_corner_scan(), true, edges, planes);
+    *ground = *at_corner = 0;
+    for (const auto& e : edges) {
+      if ((e.head<2>() - Eigen::Vector2f(12, 12)).norm() < 0.5f) ++*at_corner;
+      else if (e.z() < -1.5f) ++*ground;
+    }
+  };
+  std::size_t ground_plain, corner_plain, ground_floor, corner_floor;
+  count(0.0, &ground_plain, &corner_plain);
+  count(40.0, &ground_floor, &corner_floor);
+  std::printf("ground edges %zu -> %zu, corner edges %zu -> %zu\n", ground_plain, ground_floor,
+              corner_plain, corner_floor);
+  EXPECT_GT(ground_plain, 1000u);              // without the floor: noise edges everywhere
+  EXPECT_LT(ground_floor, ground_plain / 50);  // with it: almost none
+  EXPECT_GE(corner_floor, 10u);                // the corner, seen by ~30 rings, stays
+  EXPECT_GE(corner_floor, corner_plain / 2);
 }
 
 TEST(FeatureExtractor, RangeCropDropsNearFarAndNonFinitePoints) {

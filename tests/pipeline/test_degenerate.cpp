@@ -92,6 +92,16 @@ double worst_step_error_m(const PoseList& est, const PoseList& gt, std::size_t a
   return worst;
 }
 
+// What a constant-velocity motion model alone makes of frames a..b: the ground-truth motion of
+// frame a (from a-1) repeated b-a times, against the true motion from a to b. A fallback that
+// keeps the prediction along a weak direction can do no better than this from its entry.
+double constant_velocity_error_m(const PoseList& gt, std::size_t a, std::size_t b) {
+  const Eigen::Isometry3d step = gt[a - 1].inverse() * gt[a];
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  for (std::size_t i = a; i < b; ++i) T = T * step;
+  return (T.translation() - (gt[a].inverse() * gt[b]).translation()).norm();
+}
+
 }  // namespace
 
 // A straight tunnel: inside, scan matching cannot see motion along the axis. The odometry must
@@ -103,18 +113,18 @@ TEST(Degenerate, TunnelIsFlaggedAndTheOdometryRecoversAfterTheExit) {
   ASSERT_GT(scene.end, scene.first + 50);
   const auto [odometry, optimized] = run_both(*source);
   const PoseList& est = odometry.T_world_lidar;
-  // Along the tunnel: the error over the tunnel, reported; the bound is the motion model's:
-  // the speed changes by at most ~2 m/s over the tunnel, so a constant-velocity fallback is
-  // off by at most half of (2 m/s x time inside).
-  const double inside_s = (scene.end - scene.first) * 0.1;
+  // Along the tunnel the bound is the motion model's own: constant velocity from the entry.
+  // (The car accelerates from 11.6 to 13.5 m/s inside, so that is ~20 m over the ~210 m
+  // tunnel; an estimate that stalls, as one held by a spurious constraint does, is ~210 m off.)
   const double tunnel_error = motion_error_m(est, gt, scene.first, scene.end - 1);
+  const double model_error = constant_velocity_error_m(gt, scene.first, scene.end - 1);
   const double tunnel_m = (gt[scene.end - 1].translation() - gt[scene.first].translation()).norm();
-  std::printf("tunnel: %zu degenerate frames flagged of %zu inside; %.0f m inside, error over it %.2f m; "
-              "worst step after exit %.3f m\n",
-              odometry.degenerate_frames, scene.end - scene.first, tunnel_m, tunnel_error,
+  std::printf("tunnel: %zu degenerate frames flagged of %zu inside; %.0f m inside, error over it %.2f m "
+              "(constant velocity from the entry: %.2f m); worst step after exit %.3f m\n",
+              odometry.degenerate_frames, scene.end - scene.first, tunnel_m, tunnel_error, model_error,
               worst_step_error_m(est, gt, scene.end + 10, gt.size()));
   EXPECT_GE(odometry.degenerate_frames, (scene.end - scene.first) / 4);
-  EXPECT_LT(tunnel_error, 0.5 * 2.0 * inside_s);
+  EXPECT_LT(tunnel_error, model_error);
   // Recovered: 1 s after the exit, every frame's motion is right within 5 cm.
   EXPECT_LT(worst_step_error_m(est, gt, scene.end + 10, gt.size()), 0.05);
   EXPECT_LT(worst_step_error_m(optimized.T_world_lidar, gt, scene.end + 10, gt.size()), 0.05);

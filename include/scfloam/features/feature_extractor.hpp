@@ -13,8 +13,11 @@
 
 namespace scfloam {
 
-// Curvature of each point of one ring in F-LOAM's unit: squared norm of (sum of the
-// 2*half_window neighbours - 2*half_window * p). Points within half_window of either end get 0.
+// Curvature of each point of one ring in F-LOAM's unit: squared norm of d = (sum of the
+// 2*half_window neighbours - 2*half_window * p), keeping only d's part perpendicular to the
+// chord between the means of the neighbours before and after p (so uneven spacing, as from a
+// dropped return, is not curvature; on evenly spaced points it is F-LOAM's value). Points
+// within half_window of either end get 0.
 void ring_curvature(const Eigen::Vector3f* points, int n, int half_window, float* curvature);
 
 // Rotates each point up by `angle_deg` in its own vertical plane (KITTI's beams read ~0.22 deg
@@ -58,6 +61,7 @@ class FeatureExtractor {
   std::vector<float> curvature_;
   std::vector<char> picked_, unreliable_;
   std::vector<std::vector<int>> candidates_;     // per ring scratch
+  std::vector<std::vector<float>> noise_scratch_;  // per ring: curvatures for the median
   std::vector<FeatureCloud> ring_edges_, ring_planes_;
   std::vector<char> ring_resorted_;                            // per ring, last extract()
   std::vector<std::vector<std::pair<float, int>>> sort_scratch_;  // per ring
