@@ -86,14 +86,18 @@ Scenario tunnel(std::uint64_t seed, std::size_t frames, double mount) {
   return sc;
 }
 
-// ---- open field: flat ground, a few far barns and tree groups -----------------------------
+// ---- open field: a village, open ground with a few far barns and trees, a village ---------
 Scenario open_field(std::uint64_t seed, std::size_t frames, double mount) {
+  // The villages at both ends give the odometry its speed before the field and structure to
+  // recover on after it, as the streets around the tunnel do.
+  constexpr double kYard = 60;
   if (frames == 0) frames = 300;
   Rng rng(hash_combine(seed, 0xF1E1DULL));
   const double phase = rng.uniform(0, 2 * M_PI), bend_phase = rng.uniform(0, 2 * M_PI);
   auto speed = [&](double t) { return 9.0 + 1.2 * std::sin(2 * M_PI * t / 30 + phase) - 1.2 * std::sin(phase); };
   const std::vector<double> s = integrate_speed(speed, (frames + 1) * kFramePeriod, 0.01);
-  const double route = s[frames * 10] + 300;
+  const double drive = s[frames * 10], route = drive + 300;
+  if (drive < 2 * kYard + 40) throw Error("the open-field scene needs at least 160 frames");
   // A gently bending farm track (curvature <= 0.004 /m).
   std::vector<Vec2> lane;
   for (double x = 0; x <= route; x += 1.0) lane.emplace_back(x, 12 * std::sin(2 * M_PI * x / 350 + bend_phase));
@@ -106,9 +110,22 @@ Scenario open_field(std::uint64_t seed, std::size_t frames, double mount) {
   sc.world.curb_height_m = 0;  // no curbs: one continuous surface
   sc.world.road_reflectance = 0.3f;
   const auto& terrain = sc.world.terrain_m;
-  for (double xo = rng.uniform(30, 90); xo < route; xo += rng.uniform(120, 200)) {
+  auto lane_y = [&](double x) { return 12 * std::sin(2 * M_PI * x / 350 + bend_phase); };
+  // Each yard is a village street: farm buildings 8-16 m from the track on both sides, one
+  // every 8-14 m, turned at random.
+  for (const double x0 : {-30.0, drive - kYard}) {
+    for (const double side : {-1.0, 1.0}) {
+      for (double x = x0 + rng.uniform(0, 8); x < x0 + kYard + 30; x += rng.uniform(8, 14)) {
+        const double yo = lane_y(x) + side * rng.uniform(8, 16), g = terrain.sample(x, yo);
+        sc.world.primitives.push_back(make_box(x, yo, rng.uniform(0, M_PI), rng.uniform(2, 4), rng.uniform(3, 6), g - 1,
+                                               g + rng.uniform(3, 8), SurfaceKind::wall, static_cast<float>(rng.uniform(0.2, 0.5))));
+        ++sc.stats.buildings;
+      }
+    }
+  }
+  for (double xo = kYard + rng.uniform(30, 90); xo < route; xo += rng.uniform(120, 200)) {
     const double side = rng.chance(0.5) ? 1 : -1;
-    const double yo = 12 * std::sin(2 * M_PI * xo / 350 + bend_phase) + side * rng.uniform(45, 110);
+    const double yo = lane_y(xo) + side * rng.uniform(45, 110);
     const double g = terrain.sample(xo, yo);
     if (rng.chance(0.5)) {  // a barn
       sc.world.primitives.push_back(make_box(xo, yo, rng.uniform(0, M_PI), rng.uniform(4, 6), rng.uniform(7, 12), g - 1,
@@ -129,10 +146,14 @@ Scenario open_field(std::uint64_t seed, std::size_t frames, double mount) {
   sc.world.build_index();
   sc.trajectory = drive_arclength(lane, false, s, 0.01, ground_of(sc.world), mount);
   sc.frames = frames;
-  sc.degenerate_first_frame = 0;
-  sc.degenerate_end_frame = frames;
+  for (std::size_t k = 0; k < frames; ++k) {
+    const double xk = sc.frame_pose(k).translation().x();
+    if (xk >= kYard && sc.degenerate_first_frame == 0) sc.degenerate_first_frame = k;
+    if (xk <= drive - kYard) sc.degenerate_end_frame = k + 1;
+  }
   set_route_length(sc);
-  sc.description = "open-field: flat open ground, a barn or a group of trees every 120-200 m, 45-110 m off the track";
+  sc.description = "open-field: 60 m of village street, " + std::to_string(static_cast<int>(drive - 2 * kYard)) +
+                   " m of flat open ground (a barn or a group of trees every 120-200 m, 45-110 m off the track), 60 m of village street";
   return sc;
 }
 
