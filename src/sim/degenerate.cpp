@@ -99,8 +99,9 @@ Scenario open_field(std::uint64_t seed, std::size_t frames, double mount) {
   const double drive = s[frames * 10], route = drive + 300;
   if (drive < 2 * kYard + 40) throw Error("the open-field scene needs at least 160 frames");
   // A gently bending farm track (curvature <= 0.004 /m).
+  auto lane_y = [&](double x) { return 12 * std::sin(2 * M_PI * x / 350 + bend_phase); };
   std::vector<Vec2> lane;
-  for (double x = 0; x <= route; x += 1.0) lane.emplace_back(x, 12 * std::sin(2 * M_PI * x / 350 + bend_phase));
+  for (double x = 0; x <= route; x += 1.0) lane.emplace_back(x, lane_y(x));
 
   Scenario sc;
   const WorldBounds bounds{-200, -300, route + 200, 300};
@@ -110,7 +111,6 @@ Scenario open_field(std::uint64_t seed, std::size_t frames, double mount) {
   sc.world.curb_height_m = 0;  // no curbs: one continuous surface
   sc.world.road_reflectance = 0.3f;
   const auto& terrain = sc.world.terrain_m;
-  auto lane_y = [&](double x) { return 12 * std::sin(2 * M_PI * x / 350 + bend_phase); };
   // Each yard is a village street: farm buildings 8-16 m from the track on both sides, one
   // every 8-14 m, turned at random.
   for (const double x0 : {-30.0, drive - kYard}) {
