@@ -84,9 +84,18 @@ struct RegistrationConfig {
   // Same for the rotation block (units: residuals x lever arm^2 in m^2; a frame's structure
   // 5-30 m away gives 10^4 and more, a flat open field ~0 about the vertical).
   double degeneracy_min_rotation_eigenvalue = 50.0;
-  // Solution remapping: along the weak eigenvectors (of either block) the solve keeps the
-  // constant-velocity prediction and moves only in the well-constrained directions.
+  // Along the weak eigenvectors (of either block) the constant-velocity prediction enters the
+  // solve as a prior with the weights below, so the matches decide there only as far as their
+  // information outweighs it (docs/odometry.md, "Degenerate scenes").
   bool degeneracy_fallback = true;
+  // The prior's weight along a weak translation (rotation) direction, in the units of J^T J:
+  // (residual noise / prediction error per frame)^2. With ~5 cm residuals and a car's 3 m/s^2
+  // (0.5 rad/s^2) changing a 10 Hz step by 3 cm (0.005 rad): 3 and 100 m^2. A direction with
+  // no information keeps the prediction; one matched by 50 residuals moves 94 % of the way
+  // to where they say. 0: the weak directions keep the prediction exactly (solution
+  // remapping, Zhang et al. 2016).
+  double degeneracy_prior_translation_weight = 3.0;
+  double degeneracy_prior_rotation_weight = 100.0;
   // Relative test (registration/degeneracy.hpp): an eigenvalue of the translation (rotation)
   // block below this fraction of the block's largest is weak. Measured per frame (session 6,
   // docs/degenerate.md): simulated city, KITTI-05-like and real KITTI >= 0.17 and >= 0.058;

@@ -65,6 +65,8 @@ std::vector<Binding> bindings(SlamConfig& c) {
       {reg, "degeneracy_min_rotation_eigenvalue",
        &o.registration.degeneracy_min_rotation_eigenvalue},
       {reg, "degeneracy_fallback", &o.registration.degeneracy_fallback},
+      {reg, "degeneracy_prior_translation_weight", &o.registration.degeneracy_prior_translation_weight},
+      {reg, "degeneracy_prior_rotation_weight", &o.registration.degeneracy_prior_rotation_weight},
       {reg, "degeneracy_min_translation_ratio", &o.registration.degeneracy_min_translation_ratio},
       {reg, "degeneracy_min_rotation_ratio", &o.registration.degeneracy_min_rotation_ratio},
       {reg, "coarse_neighbor_dist_m", &o.registration.coarse_neighbor_dist_m},
@@ -211,6 +213,10 @@ void check_ranges(const SlamConfig& c, const std::filesystem::path& path) {
   require(o.registration.unconverged_rotation_deg >= 0,
           "odometry.registration.unconverged_rotation_deg", ">= 0");
   require(o.registration.num_threads >= 1, "odometry.registration.num_threads", ">= 1");
+  require(o.registration.degeneracy_prior_translation_weight >= 0,
+          "odometry.registration.degeneracy_prior_translation_weight", ">= 0");
+  require(o.registration.degeneracy_prior_rotation_weight >= 0,
+          "odometry.registration.degeneracy_prior_rotation_weight", ">= 0");
   require(o.map.edge_spacing_m >= 0, "odometry.map.edge_spacing_m", ">= 0");
   require(o.map.plane_spacing_m >= 0, "odometry.map.plane_spacing_m", ">= 0");
   require(o.map.max_points_per_cell >= 1, "odometry.map.max_points_per_cell", ">= 1");

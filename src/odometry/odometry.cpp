@@ -155,12 +155,15 @@ OdometryResult Odometry::process(const Scan& scan) {
                       : T_pred;
     // The fallback trusts the prediction along weak directions; an extrapolation over r
     // intervals is ~r^2 times less certain (velocity error x time), so over a gap a direction
-    // is weak only when its condition ratio is that much smaller.
+    // is weak only when its condition ratio is that much smaller, and the prediction's weight
+    // there (inverse variance) is r^4 times smaller.
     std::unique_ptr<ScanToMapRegistration> gap_registration;
     if (gap) {
       RegistrationConfig relaxed = c.registration;
       relaxed.degeneracy_min_translation_ratio /= ratio * ratio;
       relaxed.degeneracy_min_rotation_ratio /= ratio * ratio;
+      relaxed.degeneracy_prior_translation_weight /= std::pow(ratio, 4);
+      relaxed.degeneracy_prior_rotation_weight /= std::pow(ratio, 4);
       gap_registration = std::make_unique<ScanToMapRegistration>(relaxed);
     }
     ScanToMapRegistration& registration = gap ? *gap_registration : s.registration;

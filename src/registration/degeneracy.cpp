@@ -1,6 +1,7 @@
 #include "scfloam/registration/degeneracy.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <utility>
 
 namespace scfloam {
 
@@ -30,12 +31,24 @@ Degeneracy::Degeneracy(const Eigen::Matrix<double, 6, 6>& H, const RegistrationC
                         config.degeneracy_min_translation_ratio);
 }
 
-Eigen::Matrix<double, 6, Eigen::Dynamic> Degeneracy::basis(bool strong) const {
-  const int nr = strong ? 3 - weak_rot : weak_rot, nt = strong ? 3 - weak_tra : weak_tra;
-  Eigen::Matrix<double, 6, Eigen::Dynamic> B = Eigen::Matrix<double, 6, Eigen::Dynamic>::Zero(6, nr + nt);
-  const int r0 = strong ? weak_rot : 0, t0 = strong ? weak_tra : 0;
-  for (int i = 0; i < nr; ++i) B.block<3, 1>(0, i) = rot_vectors.col(r0 + i);
-  for (int i = 0; i < nt; ++i) B.block<3, 1>(3, nr + i) = tra_vectors.col(t0 + i);
+Eigen::Matrix<double, 6, Eigen::Dynamic> Degeneracy::directions(Part rotation,
+                                                                Part translation) const {
+  // Columns [first, end) of a block's ascending eigenvectors: the weak ones come first.
+  const auto range = [](Part part, int weak) -> std::pair<int, int> {
+    switch (part) {
+      case Part::kWeak: return {0, weak};
+      case Part::kStrong: return {weak, 3};
+      case Part::kAll: return {0, 3};
+      case Part::kNone: break;
+    }
+    return {0, 0};
+  };
+  const auto [r0, r1] = range(rotation, weak_rot);
+  const auto [t0, t1] = range(translation, weak_tra);
+  const int nr = r1 - r0;
+  Eigen::Matrix<double, 6, Eigen::Dynamic> B = Eigen::Matrix<double, 6, Eigen::Dynamic>::Zero(6, nr + t1 - t0);
+  for (int i = r0; i < r1; ++i) B.block<3, 1>(0, i - r0) = rot_vectors.col(i);
+  for (int i = t0; i < t1; ++i) B.block<3, 1>(3, nr + i - t0) = tra_vectors.col(i);
   return B;
 }
 

@@ -239,6 +239,47 @@ class SmallStepStop : public ceres::IterationCallback {
   double tolerance_;
 };
 
+// The prediction as a prior along weak directions: rows sqrt(w) b^T (pose [-] prediction) for
+// each column b of `rotations` (weight w_rot) and `translations` (w_tra), [-] being
+// PoseManifold::Minus. Its Jacobian is MinusJacobian's (exact at the prediction; a solve moves
+// a few centimetres and milliradians from it).
+class WeakDirectionPrior : public ceres::CostFunction {
+ public:
+  WeakDirectionPrior(const double* prediction, const Basis6& rotations, double w_rot,
+                     const Basis6& translations, double w_tra)
+      : rows_(rotations.cols() + translations.cols(), 6) {
+    std::copy(prediction, prediction + 7, prediction_);
+    const auto nr = rotations.cols();
+    if (nr > 0) rows_.topRows(nr) = std::sqrt(w_rot) * rotations.transpose();
+    if (translations.cols() > 0) rows_.bottomRows(translations.cols()) = std::sqrt(w_tra) * translations.transpose();
+    set_num_residuals(static_cast<int>(rows_.rows()));
+    mutable_parameter_block_sizes()->push_back(7);
+  }
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    Eigen::Matrix<double, 6, 1> d;
+    manifold_.Minus(parameters[0], prediction_, d.data());
+    Eigen::Map<Eigen::VectorXd>(residuals, rows_.rows()) = rows_ * d;
+    if (jacobians && jacobians[0]) {
+      Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, 7, Eigen::RowMajor>> J(jacobians[0], rows_.rows(), 7);
+      J.setZero();
+      J.leftCols<6>() = rows_;
+    }
+    return true;
+  }
+
+ private:
+  double prediction_[7];
+  Eigen::Matrix<double, Eigen::Dynamic, 6> rows_;
+  PoseManifold manifold_;
+};
+
+// How the fallback treats a block's weak directions: with a prior weight of 0 they are frozen
+// at the prediction (solution remapping), otherwise the prediction is a prior there.
+Degeneracy::Part frozen_part(double prior_weight) {
+  return prior_weight > 0 ? Degeneracy::Part::kNone : Degeneracy::Part::kWeak;
+}
+
 bool finite_pose(const double* pose) {
   for (int i = 0; i < 7; ++i)
     if (!std::isfinite(pose[i])) return false;
@@ -261,6 +302,8 @@ RegistrationResult ScanToMapRegistration::align(const FeatureCloud& edges_lidar,
   edge_out_.clear();
   plane_out_.clear();
 
+  const double w_rot = config_.degeneracy_prior_rotation_weight;
+  const double w_tra = config_.degeneracy_prior_translation_weight;
   const int max_rounds = std::max(rounds, config_.outer_iterations_max);
   for (int round = 0; round < max_rounds; ++round) {
     find_matches(edges_lidar, planes_lidar, map, block_to_pose(pose), round == 0);
@@ -268,11 +311,24 @@ RegistrationResult ScanToMapRegistration::align(const FeatureCloud& edges_lidar,
     // Degenerate directions of this round's matches: the solver may not move along them
     // (they would follow noise, and through the nonlinearity disturb the other directions).
     std::unique_ptr<SubspacePoseManifold> subspace;
+    std::unique_ptr<WeakDirectionPrior> prior;
     if (config_.degeneracy_fallback) {
       const Degeneracy cond(
           hessians_of(edge_out_, plane_out_, block_to_pose(pose), 0.0, arena_.get()).plain, config_);
       if (cond.weak() == 6) break;  // nothing is constrained: keep the guess
-      if (cond.weak() > 0) subspace = std::make_unique<SubspacePoseManifold>(cond.basis(true));
+      if (cond.weak() > 0) {
+        using Part = Degeneracy::Part;
+        const Part rot_frozen = frozen_part(w_rot), tra_frozen = frozen_part(w_tra);
+        // The solver moves in everything but the frozen directions.
+        if (cond.directions(rot_frozen, tra_frozen).cols() > 0)
+          subspace = std::make_unique<SubspacePoseManifold>(
+              cond.directions(rot_frozen == Part::kWeak ? Part::kStrong : Part::kAll,
+                              tra_frozen == Part::kWeak ? Part::kStrong : Part::kAll));
+        const Basis6 soft_rot = cond.directions(w_rot > 0 ? Part::kWeak : Part::kNone, Part::kNone);
+        const Basis6 soft_tra = cond.directions(Part::kNone, w_tra > 0 ? Part::kWeak : Part::kNone);
+        if (soft_rot.cols() + soft_tra.cols() > 0)
+          prior = std::make_unique<WeakDirectionPrior>(init, soft_rot, w_rot, soft_tra, w_tra);
+      }
     }
     NormalEquationCost cost(edge_out_, plane_out_, config_.huber_delta_m, arena_.get());
     ceres::Problem::Options problem_options;
@@ -282,6 +338,7 @@ RegistrationResult ScanToMapRegistration::align(const FeatureCloud& edges_lidar,
     problem.AddParameterBlock(pose, 7, subspace ? static_cast<ceres::Manifold*>(subspace.get())
                                                 : &manifold);
     problem.AddResidualBlock(&cost, nullptr, pose);
+    if (prior) problem.AddResidualBlock(prior.get(), nullptr, pose);
     ceres::Solver::Options options;
     // 6 unknowns: the normal equations are a 6x6 Cholesky; QR of the ~10^4 x 6 Jacobian cost
     // more and gains no accuracy that matters on a problem this well scaled.
@@ -321,14 +378,17 @@ RegistrationResult ScanToMapRegistration::align(const FeatureCloud& edges_lidar,
   const double sum_dist = final_h.sum_dist;
   result.hessian = config_.huber_delta_m > 0 ? final_h.robust : final_h.plain;
   const Degeneracy cond(final_h.plain, config_);
-  // Solution remapping: whatever the rounds did along the final weak directions is undone,
-  // so the pose there is the initial guess (the motion model); the strong part is kept.
+  // Solution remapping of the frozen directions: whatever the rounds did along the final weak
+  // ones is undone, so the pose there is the initial guess (the motion model). Where the
+  // prediction was a prior instead, the solve has already weighed it.
   if (config_.degeneracy_fallback && cond.weak() > 0) {
-    Eigen::Matrix<double, 6, 1> delta;
-    manifold.Minus(pose, init, delta.data());
-    const Basis6 W = cond.basis(false);
-    delta -= W * (W.transpose() * delta);
-    manifold.Plus(init, delta.data(), pose);
+    const Basis6 W = cond.directions(frozen_part(w_rot), frozen_part(w_tra));
+    if (W.cols() > 0) {
+      Eigen::Matrix<double, 6, 1> delta;
+      manifold.Minus(pose, init, delta.data());
+      delta -= W * (W.transpose() * delta);
+      manifold.Plus(init, delta.data(), pose);
+    }
     result.fallback_applied = true;
   }
   result.T_world_lidar = block_to_pose(pose);

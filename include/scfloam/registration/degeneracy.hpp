@@ -21,8 +21,14 @@ struct Degeneracy {
   Degeneracy(const Eigen::Matrix<double, 6, 6>& H, const RegistrationConfig& config);
   int weak() const { return weak_rot + weak_tra; }
 
-  // Orthonormal 6 x m basis of the well-constrained (strong) or weak tangent directions.
-  Eigen::Matrix<double, 6, Eigen::Dynamic> basis(bool strong) const;
+  // Orthonormal 6 x m basis of chosen tangent directions: of each block none, its weak ones,
+  // its strong (well-constrained) ones, or all three; rotation columns first.
+  enum class Part { kNone, kWeak, kStrong, kAll };
+  Eigen::Matrix<double, 6, Eigen::Dynamic> directions(Part rotation, Part translation) const;
+  Eigen::Matrix<double, 6, Eigen::Dynamic> basis(bool strong) const {
+    const Part p = strong ? Part::kStrong : Part::kWeak;
+    return directions(p, p);
+  }
 };
 
 }  // namespace scfloam
