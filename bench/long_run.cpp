@@ -1,13 +1,20 @@
 // Long run (issue 8): replays one simulated patrol lap (scfloam simulate --scenario patrol)
 // lap after lap with continuing stamps, through the whole pipeline, for N frames: a robot
 // patrolling for an hour. Samples the resident memory while it runs and writes
-//   OUT/memory.csv   elapsed_s, frames_read, rss_mb           (every --sample-s seconds)
+//   OUT/memory.csv   elapsed_s, frames_read, rss_mb, heap_in_use_mb, heap_free_mb, keyframes,
+//                    detection_queue, closure_queue, solves    (every --sample-s seconds)
 //   OUT/frames.csv   frame, features_ms, registration_ms       (every frame)
+//   OUT/solves.csv   elapsed_s, frames_read, nodes, free_nodes, ms  (every pose-graph solve)
 //   OUT/summary.json the run's summary.json plus what is stored per keyframe
 //   OUT/loops.csv    current_frame, loop_frame, verdict        (registered loop candidates)
-// Both CSVs are rewritten every 60 s while the run goes on, so a stopped run leaves its data.
+// heap_in_use_mb is what malloc has handed out and not got back (mallinfo2 uordblks + hblkhd),
+// heap_free_mb what it got back but keeps (fordblks): RSS growing with the first is live data,
+// with the second allocator retention. The CSVs are rewritten every 60 s while the run goes
+// on, so a stopped run leaves its data.
 // Usage: long_run LAP_DIR OUT_DIR [--frames 20000] [--mode optimized] [--sample-s 2]
 //                 [--resident-keyframes N] [--rebuild-cell-m M]  (pipeline.* keys)
+#include <malloc.h>
+
 #include <array>
 #include <atomic>
 #include <chrono>
@@ -75,6 +82,17 @@ double current_rss_mb() {
   return 0;
 }
 
+// Bytes malloc has handed out (arenas and mmapped chunks) and bytes it holds free, all
+// arenas together (glibc >= 2.33).
+struct HeapUse {
+  double in_use_mb = 0, free_mb = 0;
+};
+HeapUse current_heap() {
+  const struct mallinfo2 mi = mallinfo2();
+  return {static_cast<double>(mi.uordblks + mi.hblkhd) / (1024.0 * 1024.0),
+          static_cast<double>(mi.fordblks) / (1024.0 * 1024.0)};
+}
+
 }  // namespace
 
 int main(int argc, char** argv) try {
@@ -106,7 +124,11 @@ int main(int argc, char** argv) try {
   // Memory sampler: resident set size against frames read, while the pipeline runs; the
   // odometry's per-frame times arrive through on_frame.
   std::ostringstream memory_csv;
-  memory_csv << "elapsed_s,frames_read,rss_mb\n";
+  memory_csv << "elapsed_s,frames_read,rss_mb,heap_in_use_mb,heap_free_mb,keyframes,"
+                "detection_queue,closure_queue,solves\n";
+  std::ostringstream solves_csv;
+  solves_csv << "elapsed_s,frames_read,nodes,free_nodes,ms\n";
+  LiveCounters live;
   std::vector<std::array<double, 2>> frame_ms;
   frame_ms.reserve(frames);
   std::mutex m;
@@ -114,6 +136,7 @@ int main(int argc, char** argv) try {
   bool done = false;
   const auto write_csvs = [&] {  // m held
     write_file_atomic(out_dir / "memory.csv", memory_csv.str());
+    write_file_atomic(out_dir / "solves.csv", solves_csv.str());
     write_file_atomic(out_dir / "frames.csv", [&](std::ostream& out) {
       out << "frame,features_ms,registration_ms\n";
       char row[64];
@@ -124,13 +147,20 @@ int main(int argc, char** argv) try {
     });
   };
   const auto start = std::chrono::steady_clock::now();
+  const auto elapsed_s = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
   std::thread sampler([&] {
     std::unique_lock<std::mutex> lock(m);
     double last_write_s = 0;
     do {
-      const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      char row[96];
-      std::snprintf(row, sizeof row, "%.1f,%zu,%.1f\n", t, source.frames_read(), current_rss_mb());
+      const double t = elapsed_s();
+      const HeapUse heap = current_heap();
+      char row[160];
+      std::snprintf(row, sizeof row, "%.1f,%zu,%.1f,%.1f,%.1f,%zu,%zu,%zu,%zu\n", t,
+                    source.frames_read(), current_rss_mb(), heap.in_use_mb, heap.free_mb,
+                    live.keyframes.load(), live.detection_queue.load(), live.closure_queue.load(),
+                    live.solves.load());
       memory_csv << row;
       if (t - last_write_s > 60) {
         write_csvs();
@@ -142,6 +172,14 @@ int main(int argc, char** argv) try {
   RunOptions options;
   options.mode = *mode;
   options.progress = true;
+  options.live = &live;
+  options.on_solve = [&](const SolveSample& solve) {
+    char row[96];
+    std::snprintf(row, sizeof row, "%.1f,%zu,%zu,%zu,%.1f\n", elapsed_s(), source.frames_read(),
+                  solve.nodes, solve.free_nodes, solve.ms);
+    std::lock_guard<std::mutex> lock(m);
+    solves_csv << row;
+  };
   options.on_frame = [&](std::size_t, double features_ms, double registration_ms) {
     std::lock_guard<std::mutex> lock(m);
     frame_ms.push_back({features_ms, registration_ms});

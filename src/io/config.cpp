@@ -127,6 +127,7 @@ std::vector<Binding> bindings(SlamConfig& c) {
       {pg, "max_outlier_rounds", &g.max_outlier_rounds},
       {pg, "skip_solve_loop_chi2", &g.skip_solve_loop_chi2},
       {pg, "solve_window_margin_keyframes", &g.solve_window_margin_keyframes},
+      {pg, "solve_window_max_keyframes", &g.solve_window_max_keyframes},
       {pg, "max_iterations", &g.max_iterations},
   });
   auto& p = c.pipeline;

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <atomic>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -34,12 +35,18 @@ class LoopClosure {
   // End of the run: one solve if loops were added without one since the last (their edges
   // then inform the final poses).
   void finish();
+  // Called after every solve (a long run's monitor: window size and time); may be empty.
+  void set_on_solve(std::function<void(const SolveSample&)> on_solve) {
+    on_solve_ = std::move(on_solve);
+  }
 
   const LoopLog& log() const { return log_; }
   const PoseGraph& graph() const { return graph_; }
   std::size_t accepted_loops() const { return accepted_.load(); }  // any thread
   const std::vector<double>& registration_ms() const { return registration_ms_; }
   const std::vector<double>& optimization_ms() const { return optimization_ms_; }
+  // Time to hand free heap back to the system after each solve (malloc_trim, glibc only).
+  const std::vector<double>& heap_trim_ms() const { return heap_trim_ms_; }
   // Accepted loops added without a solve (pose_graph.skip_solve_loop_chi2).
   std::size_t solves_skipped() const { return solves_skipped_; }
   // Accepted loops whose solve waited for a backlog to clear (pipeline.max_deferred_loops).
@@ -55,6 +62,9 @@ class LoopClosure {
   // Timed solve, then publish: a window from the earliest pending loop partner (less the
   // margin) to the newest node, or with `whole_graph` every node.
   void solve(bool whole_graph = false);
+  // First node a solve frees: the earliest pending loop partner less the margin, but no
+  // earlier than the window cap allows (pose_graph.solve_window_*); 0 for the whole graph.
+  std::size_t first_free_node(bool whole_graph) const;
   // The gate in the graph (loop_detection.gate_drift_fraction > 0): distances under the
   // optimized poses, uncertainty growing with the graph path between the two keyframes.
   void apply_path_gate(LoopQuery& query, std::size_t current_kf);
@@ -70,10 +80,12 @@ class LoopClosure {
   std::unique_ptr<LoopSubmap> submap_;  // feature method: reused across consecutive loops
   std::vector<std::size_t> loop_rows_;  // loops.csv row of each loop edge, in edge order
   std::atomic<std::size_t> accepted_{0};
-  std::vector<double> registration_ms_, optimization_ms_;
+  std::vector<double> registration_ms_, optimization_ms_, heap_trim_ms_;
+  std::function<void(const SolveSample&)> on_solve_;
   std::size_t solves_skipped_ = 0, solves_deferred_ = 0, window_solves_ = 0;
   std::size_t pending_deferred_ = 0;  // deferred loops not yet solved
   std::size_t earliest_partner_;      // of the loops added since the last solve
+  std::size_t earliest_current_;      // newer end of the earliest loop since the last solve
   bool whole_solve_due_ = false;      // a window solve left older nodes out
   bool unsolved_loops_ = false;
 };

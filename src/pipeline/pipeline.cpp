@@ -116,22 +116,27 @@ class DetectionStage {
   std::vector<double> ms_;
 };
 
-// Loop detection and loop closure on their own threads, fed keyframe by keyframe.
+// Loop detection and loop closure on their own threads, fed keyframe by keyframe. `live`
+// (may be null) gets the queue depths after every push and pop.
 class LoopThreads {
  public:
   LoopThreads(DetectionStage& detection, LoopClosure& closure, const KeyframeStore& store,
-              int capacity)
-      : to_detection_(capacity), to_closure_(capacity) {
+              int capacity, LiveCounters* live)
+      : to_detection_(capacity), to_closure_(capacity), live_(live) {
     detection_thread_ = std::thread([this, &detection] {
       guarded([&] {
-        while (auto kf = to_detection_.pop())
+        while (auto kf = to_detection_.pop()) {
+          report_depths();
           to_closure_.push({*kf, detection.detect(*kf)});
+          report_depths();
+        }
       });
       to_closure_.close();
     });
     closure_thread_ = std::thread([this, &closure, &store] {
       guarded([&] {
         while (auto item = to_closure_.pop()) {
+          report_depths();
           const KeyframeStore::Hold hold(store);  // its submap views point into clouds
           const bool backlog = to_closure_.size() > 0;
           closure.add(item->keyframe, item->query, backlog);
@@ -142,7 +147,10 @@ class LoopThreads {
   }
   ~LoopThreads() { finish(); }
 
-  void push(KeyframePtr kf) { to_detection_.push(std::move(kf)); }
+  void push(KeyframePtr kf) {
+    to_detection_.push(std::move(kf));
+    report_depths();
+  }
   // Waits for every keyframe to be handled; rethrows a stage's error.
   void finish() {
     to_detection_.close();
@@ -152,6 +160,12 @@ class LoopThreads {
   }
 
  private:
+  void report_depths() {
+    if (!live_) return;
+    live_->detection_queue.store(to_detection_.size(), std::memory_order_relaxed);
+    live_->closure_queue.store(to_closure_.size(), std::memory_order_relaxed);
+  }
+
   template <typename F>
   void guarded(F&& work) {
     try {
@@ -166,6 +180,7 @@ class LoopThreads {
 
   BoundedQueue<KeyframePtr> to_detection_;
   BoundedQueue<DetectedKeyframe> to_closure_;
+  LiveCounters* live_;
   std::thread detection_thread_, closure_thread_;
   std::mutex error_mutex_;
   std::exception_ptr error_;
@@ -334,8 +349,13 @@ RunResult run_slam(const ScanSource& source, const SlamConfig& base_config,
                       options.mode == SlamMode::kSimpleSc ? LoopRegistrationMethod::kIcp
                                                           : LoopRegistrationMethod::kFeatures,
                       store);
+  closure.set_on_solve([&options](const SolveSample& sample) {
+    if (options.live) options.live->solves.fetch_add(1, std::memory_order_relaxed);
+    if (options.on_solve) options.on_solve(sample);
+  });
   std::optional<LoopThreads> threads;
-  if (loops && !deterministic) threads.emplace(detection, closure, store, config.pipeline.queue_capacity);
+  if (loops && !deterministic)
+    threads.emplace(detection, closure, store, config.pipeline.queue_capacity, options.live);
 
   ScanPrefetcher prefetcher(source, count);
   ProgressBar progress(mode_name(options.mode), count, options.progress);
@@ -347,6 +367,7 @@ RunResult run_slam(const ScanSource& source, const SlamConfig& base_config,
     wait_input_ms.push_back(waiting.elapsed_ms());
     const auto& [index, scan] = *item;
     KeyframePtr kf = odometry.process(index, scan, result);
+    if (kf && options.live) options.live->keyframes.fetch_add(1, std::memory_order_relaxed);
     if (kf && loops) {
       if (threads) {
         Stopwatch queue_watch;
@@ -383,6 +404,7 @@ RunResult run_slam(const ScanSource& source, const SlamConfig& base_config,
     result.timing_ms["loop_detection"] = detection.ms();
     result.timing_ms["loop_registration"] = closure.registration_ms();
     result.timing_ms["optimization"] = closure.optimization_ms();
+    result.timing_ms["heap_trim"] = closure.heap_trim_ms();
     result.loop_solves_skipped = closure.solves_skipped();
     result.loop_solves_deferred = closure.solves_deferred();
     result.loop_rows = closure.log().rows();

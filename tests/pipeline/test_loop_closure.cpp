@@ -157,6 +157,34 @@ TEST(LoopClosure, CorrectsADriftingOdometryOnASimulatedDrive) {
   EXPECT_LE(a.ate_corrected, w.ate_corrected + 0.05);
 }
 
+// With the window capped (pose_graph.solve_window_max_keyframes) a solve during the run frees
+// at most the newest `cap` nodes, however old the loop partner, and the run's last solve frees
+// the whole graph: the drift is still corrected.
+TEST(LoopClosure, CapsTheSolveWindowAndStillCorrectsTheDrift) {
+  SlamConfig config;
+  config.pose_graph.solve_window_max_keyframes = 60;
+  const Drive& d = drifting_drive();
+  KeyframeStore store;
+  LoopClosure closure(config, LoopRegistrationMethod::kFeatures, store);
+  std::vector<SolveSample> solves;
+  closure.set_on_solve([&](const SolveSample& s) { solves.push_back(s); });
+  close_loops(d, config, /*backlog=*/false, store, closure);
+
+  ASSERT_GE(solves.size(), 2u);
+  bool capped = false;
+  for (std::size_t i = 0; i + 1 < solves.size(); ++i) {
+    EXPECT_LE(solves[i].free_nodes, 60u) << "solve " << i << " of " << solves[i].nodes << " nodes";
+    capped |= solves[i].nodes > 61 && solves[i].free_nodes == 60;
+  }
+  EXPECT_TRUE(capped);  // the cap did bite: some solve had more nodes than it freed
+  EXPECT_EQ(solves.back().free_nodes, solves.back().nodes - 1);  // the end: every node but 0
+  expect_active_loops_fit(closure.graph(), config);
+  const Accuracy a = keyframe_accuracy(d, store);
+  std::printf("cap 60: %zu solves, ATE odometry %.2f m, corrected %.2f m\n", solves.size(),
+              a.ate_odometry, a.ate_corrected);
+  EXPECT_LE(a.ate_corrected, 0.6 * a.ate_odometry);
+}
+
 // Behind a backlog the closure stage solves once per pipeline.max_deferred_loops + 1 loops that
 // need a solve, not per loop, and still corrects the drift.
 TEST(LoopClosure, SolvesABacklogsLoopsTogetherAndStillCorrectsTheDrift) {

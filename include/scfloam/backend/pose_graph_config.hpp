@@ -31,6 +31,13 @@ struct PoseGraphConfig {
   // ends with a whole-graph solve, so offline results see every loop. < 0: every solve frees
   // the whole graph.
   int solve_window_margin_keyframes = 100;
+  // ... and at most this many of the newest nodes, however old the earliest partner: on a
+  // patrol a loop to the first lap freed nearly the whole graph (20 000 frames: 4000-5900 of
+  // 6000 nodes, solves of seconds, the closure queue full), while that lap's nodes, placed by
+  // earlier solves, can as well anchor the loop as fixed nodes; 1000 is about three patrol laps
+  // (docs/robustness-long-run.md, session 7). The run's final whole-graph solve still frees
+  // every node. 0: no cap (window from the partner only).
+  int solve_window_max_keyframes = 1000;
   int max_iterations = 50;
 };
 

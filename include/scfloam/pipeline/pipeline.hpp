@@ -27,6 +27,21 @@ enum class SlamMode {
 std::optional<SlamMode> parse_mode(const std::string& name);
 std::string mode_name(SlamMode mode);
 
+// Counters the stages update while a run goes on, for a monitor on another thread (a long
+// run's memory sampler): which queue holds how many keyframes when memory grows.
+struct LiveCounters {
+  std::atomic<std::size_t> keyframes{0};        // made by the odometry so far
+  std::atomic<std::size_t> detection_queue{0};  // keyframes waiting for loop detection
+  std::atomic<std::size_t> closure_queue{0};    // keyframes waiting for loop closure
+  std::atomic<std::size_t> solves{0};           // pose-graph solves so far
+};
+
+// One pose-graph solve during the run: how many nodes it freed, of how many, and its time.
+struct SolveSample {
+  std::size_t free_nodes = 0, nodes = 0;
+  double ms = 0;
+};
+
 struct RunOptions {
   SlamMode mode = SlamMode::kOdometry;
   std::size_t max_frames = 0;  // 0: every scan of the source
@@ -38,6 +53,11 @@ struct RunOptions {
   // Called on the odometry's thread after every frame (frame, features_ms, registration_ms):
   // lets a long run record its timings while it goes on.
   std::function<void(std::size_t, double, double)> on_frame;
+  // Updated by the stages as they go (may be null); must outlive run_slam.
+  LiveCounters* live = nullptr;
+  // Called after every pose-graph solve, on the thread that solves (the loop-closure thread;
+  // run_slam's own for the run's final solve and in deterministic mode).
+  std::function<void(const SolveSample&)> on_solve;
 };
 
 // Where the keyframes' clouds are at the end of a run (pipeline.resident_keyframes).
