@@ -30,8 +30,9 @@ class PoseManifold : public ceres::Manifold {
 
 // PoseManifold restricted to a subspace of its tangent: delta = B a, with B's columns an
 // orthonormal basis (6 x m, 1 <= m <= 6) of the directions the solver may move in. Used when
-// the scan-to-map problem is degenerate: the weak directions keep the prediction
-// (solution remapping, Zhang et al. 2016) instead of following noise.
+// the scan-to-map problem is degenerate and a block's prior weight is 0: its weak directions
+// keep the prediction (solution remapping, Zhang et al. 2016). With the default weights the
+// prediction is a prior there instead (scan_to_map.cpp, WeakDirectionPrior).
 class SubspacePoseManifold : public ceres::Manifold {
  public:
   explicit SubspacePoseManifold(const Eigen::Matrix<double, 6, Eigen::Dynamic>& basis)
