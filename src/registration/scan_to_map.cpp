@@ -275,9 +275,16 @@ class WeakDirectionPrior : public ceres::CostFunction {
 };
 
 // How the fallback treats a block's weak directions: with a prior weight of 0 they are frozen
-// at the prediction (solution remapping), otherwise the prediction is a prior there.
+// at the prediction (solution remapping), otherwise the prediction is a prior there. Per
+// block: the directions frozen, those the solver may move in, those under the prior.
 Degeneracy::Part frozen_part(double prior_weight) {
   return prior_weight > 0 ? Degeneracy::Part::kNone : Degeneracy::Part::kWeak;
+}
+Degeneracy::Part free_part(double prior_weight) {
+  return prior_weight > 0 ? Degeneracy::Part::kAll : Degeneracy::Part::kStrong;
+}
+Degeneracy::Part prior_part(double prior_weight) {
+  return prior_weight > 0 ? Degeneracy::Part::kWeak : Degeneracy::Part::kNone;
 }
 
 bool finite_pose(const double* pose) {
@@ -318,14 +325,11 @@ RegistrationResult ScanToMapRegistration::align(const FeatureCloud& edges_lidar,
       if (cond.weak() == 6) break;  // nothing is constrained: keep the guess
       if (cond.weak() > 0) {
         using Part = Degeneracy::Part;
-        const Part rot_frozen = frozen_part(w_rot), tra_frozen = frozen_part(w_tra);
-        // The solver moves in everything but the frozen directions.
-        if (cond.directions(rot_frozen, tra_frozen).cols() > 0)
+        if (cond.directions(frozen_part(w_rot), frozen_part(w_tra)).cols() > 0)
           subspace = std::make_unique<SubspacePoseManifold>(
-              cond.directions(rot_frozen == Part::kWeak ? Part::kStrong : Part::kAll,
-                              tra_frozen == Part::kWeak ? Part::kStrong : Part::kAll));
-        const Basis6 soft_rot = cond.directions(w_rot > 0 ? Part::kWeak : Part::kNone, Part::kNone);
-        const Basis6 soft_tra = cond.directions(Part::kNone, w_tra > 0 ? Part::kWeak : Part::kNone);
+              cond.directions(free_part(w_rot), free_part(w_tra)));
+        const Basis6 soft_rot = cond.directions(prior_part(w_rot), Part::kNone);
+        const Basis6 soft_tra = cond.directions(Part::kNone, prior_part(w_tra));
         if (soft_rot.cols() + soft_tra.cols() > 0)
           prior = std::make_unique<WeakDirectionPrior>(init, soft_rot, w_rot, soft_tra, w_tra);
       }
