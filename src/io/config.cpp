@@ -110,6 +110,7 @@ std::vector<Binding> bindings(SlamConfig& c) {
       {lr, "rounds", &l.rounds},
       {lr, "min_inlier_fraction", &l.min_inlier_fraction},
       {lr, "max_mean_residual_m", &l.max_mean_residual_m},
+      {lr, "information_inflation", &l.information_inflation},
       {lr, "icp_leaf_m", &l.icp_leaf_m},
       {lr, "icp_max_correspondence_m", &l.icp_max_correspondence_m},
       {lr, "icp_max_iterations", &l.icp_max_iterations},
@@ -219,6 +220,8 @@ void check_ranges(const SlamConfig& c, const std::filesystem::path& path) {
   require(o.registration.degeneracy_prior_rotation_weight >= 0,
           "odometry.registration.degeneracy_prior_rotation_weight", ">= 0");
   require(o.map.edge_spacing_m >= 0, "odometry.map.edge_spacing_m", ">= 0");
+  require(c.loop_registration.information_inflation >= 0,
+          "loop_registration.information_inflation", ">= 0");
   require(o.map.plane_spacing_m >= 0, "odometry.map.plane_spacing_m", ">= 0");
   require(o.map.max_points_per_cell >= 1, "odometry.map.max_points_per_cell", ">= 1");
   require(o.map.radius_m > 0, "odometry.map.radius_m", "> 0");

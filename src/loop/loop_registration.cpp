@@ -1,5 +1,6 @@
 #include "scfloam/loop/loop_registration.hpp"
 
+#include <Eigen/Cholesky>
 #include <cmath>
 #include <cstdio>
 
@@ -81,6 +82,31 @@ const FeatureMap& LoopSubmap::coarse() const {
   return *coarse_;
 }
 
+Eigen::Matrix<double, 6, 6> loop_edge_information(const RegistrationResult& r,
+                                                  const Eigen::Isometry3d& T_anchor_loop,
+                                                  double inflation) {
+  using Matrix6 = Eigen::Matrix<double, 6, 6>;
+  if (!(inflation > 0) || !(r.residual_variance_m2 > 0)) return Matrix6::Zero();
+  // The registration moves T_anchor_current = (R, t) to (Exp(w) R, t + v): a left perturbation
+  // of T_anchor_current by the twist [w; v + t x w] (rotation first), i.e. M [w; v].
+  Matrix6 M = Matrix6::Identity();
+  M.block<3, 3>(3, 0) = skew(r.T_world_lidar.translation());
+  // In the loop keyframe's frame that twist is Ad(T_loop_anchor) of it, and the edge residual
+  // of E = T_loop_current T_current_loop' (~ identity at the solution) moves by the same twist.
+  const Eigen::Isometry3d T_loop_anchor = T_anchor_loop.inverse();
+  const Eigen::Matrix3d R = T_loop_anchor.linear();
+  Matrix6 Ad = Matrix6::Zero();
+  Ad.block<3, 3>(0, 0) = R;
+  Ad.block<3, 3>(3, 3) = R;
+  Ad.block<3, 3>(3, 0) = skew(T_loop_anchor.translation()) * R;
+  const Matrix6 N = Ad * M;  // residual = N * delta
+  const Matrix6 N_inv = N.inverse();
+  Matrix6 info = N_inv.transpose() * (r.hessian / (r.residual_variance_m2 * inflation)) * N_inv;
+  info = 0.5 * (info + info.transpose());
+  if (!info.allFinite() || info.llt().info() != Eigen::Success) return Matrix6::Zero();
+  return info;
+}
+
 LoopMatch register_loop_features(const KeyframeView& current, const LoopSubmap& submap,
                                  const Eigen::Isometry3d& T_world_anchor,
                                  const Eigen::Isometry3d& T_world_loop, double sc_yaw_rad,
@@ -114,6 +140,8 @@ LoopMatch register_loop_features(const KeyframeView& current, const LoopSubmap& 
                                                    fine_start, config.rounds);
     LoopMatch match;
     match.T_loop_current = T_anchor_loop.inverse() * r.T_world_lidar;
+    if (config.information_inflation > 0)
+      match.information = loop_edge_information(r, T_anchor_loop, config.information_inflation);
     match.inlier_fraction = static_cast<double>(r.edge_matches + r.plane_matches) / features;
     match.residual_m = r.mean_residual_m;
     match.accepted = match.inlier_fraction >= config.min_inlier_fraction &&

@@ -1,5 +1,6 @@
 #include "pipeline/loop_closure.hpp"
 
+#include <Eigen/Cholesky>
 #include <algorithm>
 #include <cstdlib>
 #include <limits>
@@ -118,7 +119,12 @@ bool LoopClosure::add(const KeyframePtr& keyframe, const LoopQuery& detected, bo
   if (!match.accepted) return false;
 
   // Edge from the current keyframe to the loop keyframe.
-  graph_.add_loop_edge(k, loop_kf, match.T_loop_current.inverse(), config_.pose_graph);
+  if (match.information.isZero()) {
+    graph_.add_loop_edge(k, loop_kf, match.T_loop_current.inverse(), config_.pose_graph);
+  } else {  // the match's own information (loop_edge_information): L^T L = information
+    const Eigen::Matrix<double, 6, 6> L = match.information.llt().matrixU();
+    graph_.add_edge({k, loop_kf, match.T_loop_current.inverse(), L, true});
+  }
   loop_rows_.push_back(*row);
   earliest_partner_ = std::min(earliest_partner_, loop_kf);
   earliest_current_ = std::min(earliest_current_, k);

@@ -174,7 +174,7 @@ using Basis6 = Eigen::Matrix<double, 6, Eigen::Dynamic>;
 // Fixed blocks summed in block order: the same sums whatever the threads.
 struct Hessians {
   Matrix6 plain = Matrix6::Zero(), robust = Matrix6::Zero();
-  double sum_dist = 0;
+  double sum_dist = 0, sum_sq = 0;
 };
 
 Hessians hessians_of(const std::vector<EdgeMatch>& edges, const std::vector<PlaneMatch>& planes,
@@ -192,6 +192,7 @@ Hessians hessians_of(const std::vector<EdgeMatch>& edges, const std::vector<Plan
       Jacobian36 J;
       Eigen::Vector3d r = edge_residual(edges[i], R, t, &J);
       h.sum_dist += r.norm();
+      h.sum_sq += r.squaredNorm();
       h.plain.noalias() += J.transpose() * J;
       if (huber_delta_m > 0) {
         robustify_huber<3>(huber_delta_m, r, &J);
@@ -202,6 +203,7 @@ Hessians hessians_of(const std::vector<EdgeMatch>& edges, const std::vector<Plan
       Jacobian16 J;
       Eigen::Matrix<double, 1, 1> r(plane_residual(planes[i - n_edges], R, t, &J));
       h.sum_dist += std::abs(r[0]);
+      h.sum_sq += r[0] * r[0];
       h.plain.noalias() += J.transpose() * J;
       if (huber_delta_m > 0) {
         robustify_huber<1>(huber_delta_m, r, &J);
@@ -218,6 +220,7 @@ Hessians hessians_of(const std::vector<EdgeMatch>& edges, const std::vector<Plan
     sum.plain += h.plain;
     sum.robust += h.robust;
     sum.sum_dist += h.sum_dist;
+    sum.sum_sq += h.sum_sq;
   }
   return sum;
 }
@@ -399,6 +402,10 @@ RegistrationResult ScanToMapRegistration::align(const FeatureCloud& edges_lidar,
   result.edge_matches = static_cast<int>(edge_out_.size());
   result.plane_matches = static_cast<int>(plane_out_.size());
   result.mean_residual_m = n ? sum_dist / n : 0;
+  // A point-to-line residual is a 3-vector across the line (2 dof), a point-to-plane one 1 dof.
+  const double dof = 2.0 * static_cast<double>(edge_out_.size()) +
+                     static_cast<double>(plane_out_.size()) - 6.0;
+  result.residual_variance_m2 = dof > 0 ? final_h.sum_sq / dof : 0;
   result.rotation_eigenvalues = cond.rot_values;
   result.translation_eigenvalues = cond.tra_values;
   result.weakest_translation_dir = cond.tra_vectors.col(0);

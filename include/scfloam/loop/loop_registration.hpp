@@ -30,7 +30,20 @@ struct LoopMatch {
   double inlier_fraction = 0;  // features matched (or, for ICP, points within 1 m)
   double residual_m = 0;       // mean point-to-line/plane distance (ICP: RMS distance)
   std::string reason;          // why it was rejected, for the log
+  // Information (inverse covariance) of the pose-graph residual of the loop edge current ->
+  // loop keyframe (measurement T_loop_current^-1), from the fine match's Hessian and residual
+  // variance (loop_edge_information). Zero when the match gives none (ICP, a degenerate
+  // match, loop_registration.information_inflation 0): the edge then takes the fixed sigmas.
+  Eigen::Matrix<double, 6, 6> information = Eigen::Matrix<double, 6, 6>::Zero();
 };
+
+// The information of a loop edge's residual [Log R_E; t_E] from a registration of the current
+// keyframe in its submap's anchor frame: r.hessian / (r.residual_variance_m2 * inflation),
+// carried from the registration's tangent at T_anchor_current to the edge's residual through
+// T_anchor_loop. Zero if that is not positive definite.
+Eigen::Matrix<double, 6, 6> loop_edge_information(const RegistrationResult& r,
+                                                  const Eigen::Isometry3d& T_anchor_loop,
+                                                  double inflation);
 
 // Initial guesses tried in order: the current poses' relative transform, then the place
 // hypothesis of Scan Context (same position, rotated by its yaw) when the first fails.

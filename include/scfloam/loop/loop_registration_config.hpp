@@ -22,6 +22,11 @@ struct LoopRegistrationConfig {
   // plane in the submap and their mean distance is below max_mean_residual_m.
   double min_inlier_fraction = 0.45;
   double max_mean_residual_m = 0.08;
+  // An accepted feature match's pose-graph edge takes its information from the match, the
+  // Hessian over the residual variance, divided by this: the residuals of neighbouring points
+  // are not independent (shared map points, the scan's own distortion), so the Hessian alone
+  // is overconfident. 0 = the fixed pose_graph.loop_*_sigma instead (as ICP loops always do).
+  double information_inflation = 0;
   // ICP baseline, SC-A-LOAM's parameters: Open3D point-to-point ICP on clouds downsampled at
   // icp_leaf_m; accepted when the mean squared correspondence distance (PCL's "fitness
   // score") is below icp_max_fitness_m2.

@@ -38,6 +38,9 @@ struct RegistrationResult {
   int edge_matches = 0;   // accepted correspondences of the final round
   int plane_matches = 0;
   double mean_residual_m = 0;  // mean point-to-line/plane distance of those, before the loss
+  // Variance of one residual component of those (sum of squares over the degrees of freedom):
+  // with `hessian`, the solution's covariance is about residual_variance_m2 * hessian^-1.
+  double residual_variance_m2 = 0;
   int rounds = 0;              // correspondence rounds actually run
   // Gauss-Newton Hessian J^T J of the final round at the solution, tangent [omega; v].
   Eigen::Matrix<double, 6, 6> hessian = Eigen::Matrix<double, 6, 6>::Zero();
