@@ -1,6 +1,6 @@
 #include "scfloam/loop/loop_registration.hpp"
 
-#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <cstdio>
 
@@ -103,7 +103,12 @@ Eigen::Matrix<double, 6, 6> loop_edge_information(const RegistrationResult& r,
   const Matrix6 N_inv = N.inverse();
   Matrix6 info = N_inv.transpose() * (r.hessian / (r.residual_variance_m2 * inflation)) * N_inv;
   info = 0.5 * (info + info.transpose());
-  if (!info.allFinite() || info.llt().info() != Eigen::Success) return Matrix6::Zero();
+  // The pose graph needs a Cholesky factor: a direction the match leaves free (eigenvalue ~0)
+  // has no information to give, and the edge falls back to the fixed sigmas.
+  if (!info.allFinite()) return Matrix6::Zero();
+  const Eigen::SelfAdjointEigenSolver<Matrix6> eig(info, Eigen::EigenvaluesOnly);
+  if (eig.info() != Eigen::Success || !(eig.eigenvalues()[0] > 1e-12 * eig.eigenvalues()[5]))
+    return Matrix6::Zero();
   return info;
 }
 

@@ -157,6 +157,32 @@ TEST(LoopClosure, CorrectsADriftingOdometryOnASimulatedDrive) {
   EXPECT_LE(a.ate_corrected, w.ate_corrected + 0.05);
 }
 
+// Loop edges weighted by their match (loop_registration.information_inflation) instead of the
+// fixed sigmas: the edges reach the graph with that information, and the drift is corrected.
+TEST(LoopClosure, MatchInformationWeightsTheLoopEdgesAndCorrectsTheDrift) {
+  SlamConfig config;
+  config.loop_registration.information_inflation = 25;
+  const Drive& d = drifting_drive();
+  KeyframeStore store;
+  LoopClosure closure(config, LoopRegistrationMethod::kFeatures, store);
+  close_loops(d, config, /*backlog=*/false, store, closure);
+
+  const Eigen::Matrix<double, 6, 6> fixed = sqrt_information_from_sigmas(
+      config.pose_graph.loop_rotation_sigma_rad, config.pose_graph.loop_translation_sigma_m);
+  std::size_t loops = 0, from_match = 0;
+  for (const PoseGraphEdge& e : closure.graph().edges()) {
+    if (!e.is_loop) continue;
+    ++loops;
+    from_match += !e.sqrt_information.isApprox(fixed);
+  }
+  const Accuracy a = keyframe_accuracy(d, store);
+  std::printf("%zu loop edges, %zu with the match's information: ATE odometry %.2f m, corrected %.2f m\n",
+              loops, from_match, a.ate_odometry, a.ate_corrected);
+  ASSERT_GE(loops, 5u);
+  EXPECT_EQ(from_match, loops);
+  EXPECT_LE(a.ate_corrected, 0.6 * a.ate_odometry);
+}
+
 // With the window capped (pose_graph.solve_window_max_keyframes) a solve during the run frees
 // at most the newest `cap` nodes, however old the loop partner, and the run's last solve frees
 // the whole graph: the drift is still corrected.
