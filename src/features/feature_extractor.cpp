@@ -5,6 +5,9 @@
 
 #include <algorithm>
 #include <cmath>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "scfloam/error.hpp"
 
@@ -44,29 +47,81 @@ void correct_elevation(FeatureCloud& points, double angle_deg) {
   }
 }
 
+namespace {
+
+// The curvature of point i from the sums of its offsets to the hw points on either side. Only
+// the part across the chord from the left to the right neighbours counts. Along the chord,
+// the sum measures uneven spacing, not shape: a dropped return on smooth ground shifts one
+// side's mean by a spacing, which at 30 m passes the edge threshold, and those ring-bound
+// "edges" pull the pose back to the last frame's (docs/degenerate.md).
+inline float curvature_across_chord(float lx, float ly, float lz, float rx, float ry, float rz) {
+  float dx = lx + rx, dy = ly + ry, dz = lz + rz;
+  const float cx = rx - lx, cy = ry - ly, cz = rz - lz;
+  const float c2 = cx * cx + cy * cy + cz * cz;
+  const float f = c2 > 0 ? (dx * cx + dy * cy + dz * cz) / c2 : 0.f;
+  dx -= f * cx;
+  dy -= f * cy;
+  dz -= f * cz;
+  return dx * dx + dy * dy + dz * dz;
+}
+
+}  // namespace
+
 void ring_curvature(const Eigen::Vector3f* p, int n, int hw, float* curvature) {
   std::fill(curvature, curvature + n, 0.f);
   if (n < 2 * hw + 1) return;
-  // Sliding sums of the hw points before and after i, in double: float prefix sums lose
-  // centimetres at 90 m ranges.
-  Eigen::Vector3d left = Eigen::Vector3d::Zero(), right = Eigen::Vector3d::Zero();
-  for (int j = 0; j < hw; ++j) left += p[j].cast<double>();
-  for (int j = hw + 1; j <= 2 * hw; ++j) right += p[j].cast<double>();
-  for (int i = hw; i < n - hw; ++i) {
-    if (i > hw) {
-      left += p[i - 1].cast<double>() - p[i - hw - 1].cast<double>();
-      right += p[i + hw].cast<double>() - p[i].cast<double>();
+  // Sums of the offsets p_j - p_i, in float: offsets between neighbours keep their precision
+  // at any range (float sums of the positions themselves lose centimetres at 90 m). The ring
+  // is copied to structure-of-arrays so that four consecutive points go through SSE2 at once;
+  // the scalar tail does the same float operations in the same order, so a point's value does
+  // not depend on where it falls.
+  thread_local std::vector<float> buffer;
+  buffer.resize(3 * static_cast<std::size_t>(n));
+  float* x = buffer.data();
+  float* y = x + n;
+  float* z = y + n;
+  for (int i = 0; i < n; ++i) {
+    x[i] = p[i].x();
+    y[i] = p[i].y();
+    z[i] = p[i].z();
+  }
+  int i = hw;
+#if defined(__SSE2__)
+  const __m128 zero = _mm_setzero_ps();
+  for (; i + 4 <= n - hw; i += 4) {
+    const __m128 px = _mm_loadu_ps(x + i), py = _mm_loadu_ps(y + i), pz = _mm_loadu_ps(z + i);
+    __m128 lx = zero, ly = zero, lz = zero, rx = zero, ry = zero, rz = zero;
+    for (int j = 1; j <= hw; ++j) {
+      lx = _mm_add_ps(lx, _mm_sub_ps(_mm_loadu_ps(x + i - j), px));
+      ly = _mm_add_ps(ly, _mm_sub_ps(_mm_loadu_ps(y + i - j), py));
+      lz = _mm_add_ps(lz, _mm_sub_ps(_mm_loadu_ps(z + i - j), pz));
+      rx = _mm_add_ps(rx, _mm_sub_ps(_mm_loadu_ps(x + i + j), px));
+      ry = _mm_add_ps(ry, _mm_sub_ps(_mm_loadu_ps(y + i + j), py));
+      rz = _mm_add_ps(rz, _mm_sub_ps(_mm_loadu_ps(z + i + j), pz));
     }
-    const Eigen::Vector3d pi = p[i].cast<double>();
-    Eigen::Vector3d d = left + right - (2 * hw) * pi;
-    // Only the part across the chord from the left to the right neighbours counts. Along the
-    // chord, d measures uneven spacing, not shape: a dropped return on smooth ground shifts
-    // one side's mean by a spacing, which at 30 m passes the edge threshold, and those
-    // ring-bound "edges" pull the pose back to the last frame's (docs/degenerate.md).
-    const Eigen::Vector3d chord = right - left;
-    const double c2 = chord.squaredNorm();
-    if (c2 > 0) d -= (d.dot(chord) / c2) * chord;
-    curvature[i] = static_cast<float>(d.squaredNorm());
+    __m128 dx = _mm_add_ps(lx, rx), dy = _mm_add_ps(ly, ry), dz = _mm_add_ps(lz, rz);
+    const __m128 cx = _mm_sub_ps(rx, lx), cy = _mm_sub_ps(ry, ly), cz = _mm_sub_ps(rz, lz);
+    const __m128 c2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(cx, cx), _mm_mul_ps(cy, cy)), _mm_mul_ps(cz, cz));
+    const __m128 dot = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, cx), _mm_mul_ps(dy, cy)), _mm_mul_ps(dz, cz));
+    // f = c2 > 0 ? dot / c2 : 0 (the division's NaN in a masked-off lane is discarded).
+    const __m128 f = _mm_and_ps(_mm_cmpgt_ps(c2, zero), _mm_div_ps(dot, c2));
+    dx = _mm_sub_ps(dx, _mm_mul_ps(f, cx));
+    dy = _mm_sub_ps(dy, _mm_mul_ps(f, cy));
+    dz = _mm_sub_ps(dz, _mm_mul_ps(f, cz));
+    _mm_storeu_ps(curvature + i, _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz)));
+  }
+#endif
+  for (; i < n - hw; ++i) {
+    float lx = 0, ly = 0, lz = 0, rx = 0, ry = 0, rz = 0;
+    for (int j = 1; j <= hw; ++j) {
+      lx += x[i - j] - x[i];
+      ly += y[i - j] - y[i];
+      lz += z[i - j] - z[i];
+      rx += x[i + j] - x[i];
+      ry += y[i + j] - y[i];
+      rz += z[i + j] - z[i];
+    }
+    curvature[i] = curvature_across_chord(lx, ly, lz, rx, ry, rz);
   }
 }
 

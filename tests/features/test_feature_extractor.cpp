@@ -43,6 +43,44 @@ TEST(Curvature, ADroppedSampleOnALineIsNotCurvature) {
   EXPECT_GT(c_corner[10], 2.f);
 }
 
+// The vectorized curvature (four points at a time, scalar tail) against the definition in
+// double, on a noisy ring far from the origin (90 m: where float sums of positions would lose
+// centimetres), at every length around the vector width and window.
+TEST(Curvature, MatchesTheDefinitionInDoubleAtAnyRingLength) {
+  std::mt19937 rng(11);
+  std::normal_distribution<double> noise(0, 0.02);
+  for (int hw : {1, 3, 5}) {
+    for (int n = 2 * hw; n <= 2 * hw + 13; ++n) {
+      std::vector<Eigen::Vector3f> ring;
+      for (int i = 0; i < n; ++i) {
+        const double az = 0.003 * i;
+        const double r = i % 7 == 3 ? 60.0 : 90.0;  // depth jumps: real corners
+        ring.emplace_back(float(r * std::cos(az) + noise(rng)), float(r * std::sin(az) + noise(rng)),
+                          float(-1.7 + noise(rng)));
+      }
+      std::vector<float> got(n, -1.f);
+      ring_curvature(ring.data(), n, hw, got.data());
+      for (int i = 0; i < n; ++i) {
+        if (i < hw || i >= n - hw) {
+          EXPECT_EQ(got[i], 0.f) << "n " << n << " i " << i;  // no full window
+          continue;
+        }
+        Eigen::Vector3d left = Eigen::Vector3d::Zero(), right = Eigen::Vector3d::Zero();
+        const Eigen::Vector3d pi = ring[i].cast<double>();
+        for (int j = 1; j <= hw; ++j) {
+          left += ring[i - j].cast<double>() - pi;
+          right += ring[i + j].cast<double>() - pi;
+        }
+        Eigen::Vector3d d = left + right;
+        const Eigen::Vector3d chord = right - left;
+        d -= (d.dot(chord) / chord.squaredNorm()) * chord;
+        const double want = d.squaredNorm();
+        EXPECT_NEAR(got[i], want, 1e-4 * want + 1e-7) << "hw " << hw << " n " << n << " i " << i;
+      }
+    }
+  }
+}
+
 LidarPoint ring_point(const Eigen::Vector3d& p, int ring) {
   LidarPoint lp;
   lp.x = float(p.x()), lp.y = float(p.y()), lp.z = float(p.z());
