@@ -4,6 +4,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -14,6 +15,8 @@
 namespace scfloam {
 
 namespace {
+
+constexpr std::size_t kMaxBeams = 128;  // the largest model (OS1-128)
 
 // atan for |x| <= 1, |error| <= 1e-5 rad (Abramowitz & Stegun 4.4.47): 5x cheaper than atan2,
 // and 6e-4 deg is far below the 1/3 deg beam spacing.
@@ -31,13 +34,57 @@ inline float elevation_deg(float z, float horizontal_range) {
   return (z < 0 ? -a : a) * kDeg;
 }
 
+#if defined(__SSE2__)
+// elevation_deg for four points: the same float operations in the same order (no FMA on
+// baseline x86-64), so each lane equals the scalar value bit for bit.
+inline __m128 elevation_deg4(__m128 z, __m128 horizontal_range) {
+  const __m128 sign = _mm_set1_ps(-0.0f);
+  const __m128 az = _mm_andnot_ps(sign, z);
+  const __m128 below = _mm_cmple_ps(az, horizontal_range);  // az <= h: atan(az / h)
+  const __m128 num = _mm_or_ps(_mm_and_ps(below, az), _mm_andnot_ps(below, horizontal_range));
+  const __m128 den = _mm_or_ps(_mm_and_ps(below, horizontal_range), _mm_andnot_ps(below, az));
+  const __m128 x = _mm_div_ps(num, den);
+  const __m128 x2 = _mm_mul_ps(x, x);
+  __m128 poly = _mm_add_ps(_mm_set1_ps(-0.0851330f), _mm_mul_ps(x2, _mm_set1_ps(0.0208351f)));
+  poly = _mm_add_ps(_mm_set1_ps(0.1801410f), _mm_mul_ps(x2, poly));
+  poly = _mm_add_ps(_mm_set1_ps(-0.3302995f), _mm_mul_ps(x2, poly));
+  poly = _mm_add_ps(_mm_set1_ps(0.9998660f), _mm_mul_ps(x2, poly));
+  const __m128 atan = _mm_mul_ps(x, poly);
+  const __m128 above = _mm_sub_ps(_mm_set1_ps(static_cast<float>(M_PI / 2)), atan);
+  __m128 a = _mm_or_ps(_mm_and_ps(below, atan), _mm_andnot_ps(below, above));
+  a = _mm_or_ps(a, _mm_and_ps(z, sign));  // z < 0: -a (a >= 0; -0 keeps +0's value)
+  return _mm_mul_ps(a, _mm_set1_ps(180.0f / static_cast<float>(M_PI)));
+}
+#endif
+
 }  // namespace
 
 void correct_elevation(FeatureCloud& points, double angle_deg) {
   if (angle_deg == 0) return;
   const float c = static_cast<float>(std::cos(angle_deg * M_PI / 180.0));
   const float s = static_cast<float>(std::sin(angle_deg * M_PI / 180.0));
-  for (Eigen::Vector3f& p : points) {
+  std::size_t i = 0;
+#if defined(__SSE2__)
+  // Four points at a time, the scalar loop's operations in its order (equal bit for bit).
+  const __m128 c4 = _mm_set1_ps(c), s4 = _mm_set1_ps(s), tiny = _mm_set1_ps(1e-3f);
+  alignas(16) float ox[4], oy[4], oz[4];
+  for (; i + 4 <= points.size(); i += 4) {
+    Eigen::Vector3f* q = points.data() + i;
+    const __m128 x = _mm_setr_ps(q[0].x(), q[1].x(), q[2].x(), q[3].x());
+    const __m128 y = _mm_setr_ps(q[0].y(), q[1].y(), q[2].y(), q[3].y());
+    const __m128 z = _mm_setr_ps(q[0].z(), q[1].z(), q[2].z(), q[3].z());
+    const __m128 h = _mm_sqrt_ps(_mm_add_ps(_mm_mul_ps(x, x), _mm_mul_ps(y, y)));
+    const __m128 keep = _mm_cmplt_ps(h, tiny);  // on the axis: left alone
+    const __m128 scale = _mm_div_ps(_mm_sub_ps(_mm_mul_ps(h, c4), _mm_mul_ps(z, s4)), h);
+    const __m128 nz = _mm_add_ps(_mm_mul_ps(z, c4), _mm_mul_ps(h, s4));
+    _mm_store_ps(ox, _mm_or_ps(_mm_and_ps(keep, x), _mm_andnot_ps(keep, _mm_mul_ps(x, scale))));
+    _mm_store_ps(oy, _mm_or_ps(_mm_and_ps(keep, y), _mm_andnot_ps(keep, _mm_mul_ps(y, scale))));
+    _mm_store_ps(oz, _mm_or_ps(_mm_and_ps(keep, z), _mm_andnot_ps(keep, nz)));
+    for (int k = 0; k < 4; ++k) q[k] = Eigen::Vector3f(ox[k], oy[k], oz[k]);
+  }
+#endif
+  for (; i < points.size(); ++i) {
+    Eigen::Vector3f& p = points[i];
     const float horizontal = std::sqrt(p.x() * p.x() + p.y() * p.y());
     if (horizontal < 1e-3f) continue;
     const float new_horizontal = horizontal * c - p.z() * s;
@@ -159,7 +206,42 @@ void FeatureExtractor::assign_rings(const std::vector<LidarPoint>& points, bool 
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks, 1), [&](const auto& range) {
     for (std::size_t b = range.begin(); b != range.end(); ++b) {
       int* counts = block_counts_.data() + b * R;
-      for (std::size_t i = b * kBlock, e = std::min(n, i + kBlock); i != e; ++i) {
+      std::size_t i = b * kBlock;
+      const std::size_t e = std::min(n, i + kBlock);
+#if defined(__SSE2__)
+      if (!use_ring_field && R <= kMaxBeams) {
+        // Four points at a time through the square root, division and atan; the lanes equal
+        // the scalar loop's values below, so the rings do not depend on the block layout.
+        const __m128 min4 = _mm_set1_ps(min_r2), max4 = _mm_set1_ps(max_r2), zero = _mm_setzero_ps();
+        const __m128 outside = _mm_set1_ps(90.0f);  // an elevation no model has a ring for
+        alignas(16) float elevation[4];
+        // Counts with a slot for "no ring" in front: no branch per point on the ring's sign
+        // (real scans interleave the beams, and that branch mispredicted on a quarter of them).
+        std::array<int, kMaxBeams + 1> local{};
+        for (; i + 4 <= e; i += 4) {
+          const LidarPoint* q = points.data() + i;
+          const __m128 x = _mm_setr_ps(q[0].x, q[1].x, q[2].x, q[3].x);
+          const __m128 y = _mm_setr_ps(q[0].y, q[1].y, q[2].y, q[3].y);
+          const __m128 z = _mm_setr_ps(q[0].z, q[1].z, q[2].z, q[3].z);
+          const __m128 r2 = _mm_add_ps(_mm_mul_ps(x, x), _mm_mul_ps(y, y));
+          // v - v is 0 for a finite v and NaN for inf or NaN.
+          __m128 ok = _mm_and_ps(_mm_cmpeq_ps(_mm_sub_ps(x, x), zero), _mm_cmpeq_ps(_mm_sub_ps(y, y), zero));
+          ok = _mm_and_ps(ok, _mm_cmpeq_ps(_mm_sub_ps(z, z), zero));
+          ok = _mm_and_ps(ok, _mm_and_ps(_mm_cmpgt_ps(r2, zero), _mm_cmpge_ps(r2, min4)));
+          ok = _mm_and_ps(ok, _mm_cmple_ps(r2, max4));
+          const __m128 el = elevation_deg4(z, _mm_sqrt_ps(r2));
+          _mm_store_ps(elevation, _mm_or_ps(_mm_and_ps(ok, el), _mm_andnot_ps(ok, outside)));
+          const auto assign = [&](int lane) {
+            const int ring = ring_from_elevation_deg(model_, elevation[lane]);
+            ring_of_[i + lane] = static_cast<std::int16_t>(ring);
+            ++local[static_cast<std::size_t>(ring + 1)];
+          };
+          assign(0), assign(1), assign(2), assign(3);
+        }
+        for (std::size_t r = 0; r < R; ++r) counts[r] += local[r + 1];
+      }
+#endif
+      for (; i != e; ++i) {
         const LidarPoint& p = points[i];
         const float r2 = p.x * p.x + p.y * p.y;
         std::int16_t ring = -1;
@@ -268,13 +350,26 @@ void FeatureExtractor::select_in_ring(int ring) {
   std::vector<int>& cand = candidates_[ring];
   for (int s = 0; s < sectors; ++s) {
     const int sb = hw + usable * s / sectors, se = hw + usable * (s + 1) / sectors;
-    cand.clear();
-    for (int i = sb; i < se; ++i)
-      if (curv[i] > threshold && !unreliable[i]) cand.push_back(i);
-    std::sort(cand.begin(), cand.end(), [&](int a, int b) { return curv[a] > curv[b]; });
+    // Candidates without a branch per point: every index is written, the count advances
+    // only for a candidate (most points are not, and the branch mispredicted).
+    cand.resize(static_cast<std::size_t>(se - sb));
+    int count = 0;
+    for (int i = sb; i < se; ++i) {
+      cand[count] = i;
+      count += static_cast<int>(curv[i] > threshold) & static_cast<int>(!unreliable[i]);
+    }
+    cand.resize(static_cast<std::size_t>(count));
+    // Strongest first (ties by position, so the order is fully defined). Only the first few
+    // are ever looked at (max_edges_per_sector, plus those suppressed by an earlier pick):
+    // order a head of the list, and the rest only if the head runs out.
+    const auto stronger = [&](int a, int b) { return curv[a] > curv[b] || (curv[a] == curv[b] && a < b); };
+    const std::size_t head = std::min(cand.size(), static_cast<std::size_t>(4 * feat_.max_edges_per_sector + 8));
+    std::partial_sort(cand.begin(), cand.begin() + static_cast<std::ptrdiff_t>(head), cand.end(), stronger);
     int chosen = 0;
-    for (int i : cand) {
+    for (std::size_t c = 0; c < cand.size(); ++c) {
       if (chosen >= feat_.max_edges_per_sector) break;
+      if (c == head) std::sort(cand.begin() + static_cast<std::ptrdiff_t>(head), cand.end(), stronger);
+      const int i = cand[c];
       if (picked[i]) continue;
       edges.push_back(p[i]);
       ++chosen;

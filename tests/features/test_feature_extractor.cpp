@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <cstdio>
 #include <random>
 
@@ -262,6 +263,67 @@ TEST(FeatureExtractor, RingsFromElevationMatchRingField) {
   b.extract(pts, true, e2, p2);
   EXPECT_EQ(e1.size(), e2.size());
   EXPECT_EQ(p1.size(), p2.size());
+}
+
+// Rings from elevation (four points at a time, scalar for a block's last few) against the ring
+// field, with invalid points (NaN, inf, too near) at every lane position and an odd total: the
+// same points survive and the same features come out, point for point.
+TEST(FeatureExtractor, RingsFromElevationMatchRingFieldAroundInvalidPoints) {
+  OdometryConfig c;
+  c.rings.lidar = "hdl64";
+  FeatureExtractor a(c.preprocess, c.rings, c.features), b(c.preprocess, c.rings, c.features);
+  std::vector<LidarPoint> pts;
+  int k = 0;
+  for (int ring = 0; ring < 64; ++ring) {
+    const double elev = (ring <= 32 ? 2.0 - ring / 3.0 : -8.83 - (ring - 32) * 0.5) + (ring == 63 ? 0.05 : -0.05);
+    for (int col = 0; col < 997; ++col, ++k) {
+      const double az = col * 2 * M_PI / 997, r = 20 + 3 * std::sin(5 * az) + (col % 50 == 7 ? 4 : 0);
+      LidarPoint p;
+      p.x = float(r * std::cos(elev * M_PI / 180) * std::cos(az));
+      p.y = float(r * std::cos(elev * M_PI / 180) * std::sin(az));
+      p.z = float(r * std::sin(elev * M_PI / 180));
+      p.ring = static_cast<std::int16_t>(ring);
+      if (k % 37 == 0) p.x = std::nanf("");
+      if (k % 41 == 1) p.z = std::numeric_limits<float>::infinity();
+      if (k % 43 == 2) p.y = -std::numeric_limits<float>::infinity();
+      if (k % 47 == 3) p.x *= 0.05f, p.y *= 0.05f;  // inside the minimum range
+      pts.push_back(p);
+    }
+  }
+  for (int extra = 0; extra < 3; ++extra) pts.push_back(pts[pts.size() - 997]);  // a scalar tail
+  ASSERT_NE(pts.size() % 4, 0u);
+  FeatureCloud e1, p1, e2, p2;
+  a.extract(pts, false, e1, p1);
+  b.extract(pts, true, e2, p2);
+  EXPECT_EQ(a.stats().kept_points, b.stats().kept_points);
+  EXPECT_LT(a.stats().kept_points, static_cast<int>(pts.size()) * 95 / 100);  // invalid ones went
+  ASSERT_EQ(e1.size(), e2.size());
+  ASSERT_EQ(p1.size(), p2.size());
+  for (std::size_t i = 0; i < e1.size(); ++i) EXPECT_EQ(e1[i], e2[i]) << i;
+  for (std::size_t i = 0; i < p1.size(); ++i) ASSERT_EQ(p1[i], p2[i]) << i;
+}
+
+// correct_elevation (four points at a time, scalar tail) against the rotation in double: each
+// point turns up by the angle in its own vertical plane; a point on the axis stays.
+TEST(FeatureExtractor, ElevationCorrectionMatchesTheRotationInDouble) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-60, 60);
+  FeatureCloud cloud;
+  for (int i = 0; i < 4 * 25 + 3; ++i) cloud.emplace_back(float(u(rng)), float(u(rng)), float(u(rng) / 10));
+  cloud[5] = Eigen::Vector3f(0, 0, 2);  // on the axis, in a vector lane
+  FeatureCloud corrected = cloud;
+  correct_elevation(corrected, 0.22);
+  const double a = 0.22 * M_PI / 180;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const Eigen::Vector3d p = cloud[i].cast<double>();
+    const double h = p.head<2>().norm();
+    Eigen::Vector3d want = p;
+    if (h >= 1e-3) {
+      const double nh = h * std::cos(a) - p.z() * std::sin(a);
+      want << p.x() * nh / h, p.y() * nh / h, p.z() * std::cos(a) + h * std::sin(a);
+    }
+    EXPECT_LT((corrected[i].cast<double>() - want).norm(), 2e-5) << i;
+  }
 }
 
 TEST(Deskew, ConstantVelocityMovesPointsToTheReferenceTime) {
