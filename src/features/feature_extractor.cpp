@@ -35,14 +35,19 @@ inline float elevation_deg(float z, float horizontal_range) {
 }
 
 #if defined(__SSE2__)
+// Per lane: mask ? a : b (SSE2 has no blend instruction).
+inline __m128 select_ps(__m128 mask, __m128 a, __m128 b) {
+  return _mm_or_ps(_mm_and_ps(mask, a), _mm_andnot_ps(mask, b));
+}
+
 // elevation_deg for four points: the same float operations in the same order (no FMA on
 // baseline x86-64), so each lane equals the scalar value bit for bit.
 inline __m128 elevation_deg4(__m128 z, __m128 horizontal_range) {
   const __m128 sign = _mm_set1_ps(-0.0f);
   const __m128 az = _mm_andnot_ps(sign, z);
   const __m128 below = _mm_cmple_ps(az, horizontal_range);  // az <= h: atan(az / h)
-  const __m128 num = _mm_or_ps(_mm_and_ps(below, az), _mm_andnot_ps(below, horizontal_range));
-  const __m128 den = _mm_or_ps(_mm_and_ps(below, horizontal_range), _mm_andnot_ps(below, az));
+  const __m128 num = select_ps(below, az, horizontal_range);
+  const __m128 den = select_ps(below, horizontal_range, az);
   const __m128 x = _mm_div_ps(num, den);
   const __m128 x2 = _mm_mul_ps(x, x);
   __m128 poly = _mm_add_ps(_mm_set1_ps(-0.0851330f), _mm_mul_ps(x2, _mm_set1_ps(0.0208351f)));
@@ -51,7 +56,7 @@ inline __m128 elevation_deg4(__m128 z, __m128 horizontal_range) {
   poly = _mm_add_ps(_mm_set1_ps(0.9998660f), _mm_mul_ps(x2, poly));
   const __m128 atan = _mm_mul_ps(x, poly);
   const __m128 above = _mm_sub_ps(_mm_set1_ps(static_cast<float>(M_PI / 2)), atan);
-  __m128 a = _mm_or_ps(_mm_and_ps(below, atan), _mm_andnot_ps(below, above));
+  __m128 a = select_ps(below, atan, above);
   a = _mm_or_ps(a, _mm_and_ps(z, sign));  // z < 0: -a (a >= 0; -0 keeps +0's value)
   return _mm_mul_ps(a, _mm_set1_ps(180.0f / static_cast<float>(M_PI)));
 }
@@ -77,9 +82,9 @@ void correct_elevation(FeatureCloud& points, double angle_deg) {
     const __m128 keep = _mm_cmplt_ps(h, tiny);  // on the axis: left alone
     const __m128 scale = _mm_div_ps(_mm_sub_ps(_mm_mul_ps(h, c4), _mm_mul_ps(z, s4)), h);
     const __m128 nz = _mm_add_ps(_mm_mul_ps(z, c4), _mm_mul_ps(h, s4));
-    _mm_store_ps(ox, _mm_or_ps(_mm_and_ps(keep, x), _mm_andnot_ps(keep, _mm_mul_ps(x, scale))));
-    _mm_store_ps(oy, _mm_or_ps(_mm_and_ps(keep, y), _mm_andnot_ps(keep, _mm_mul_ps(y, scale))));
-    _mm_store_ps(oz, _mm_or_ps(_mm_and_ps(keep, z), _mm_andnot_ps(keep, nz)));
+    _mm_store_ps(ox, select_ps(keep, x, _mm_mul_ps(x, scale)));
+    _mm_store_ps(oy, select_ps(keep, y, _mm_mul_ps(y, scale)));
+    _mm_store_ps(oz, select_ps(keep, z, nz));
     for (int k = 0; k < 4; ++k) q[k] = Eigen::Vector3f(ox[k], oy[k], oz[k]);
   }
 #endif
@@ -230,7 +235,7 @@ void FeatureExtractor::assign_rings(const std::vector<LidarPoint>& points, bool 
           ok = _mm_and_ps(ok, _mm_and_ps(_mm_cmpgt_ps(r2, zero), _mm_cmpge_ps(r2, min4)));
           ok = _mm_and_ps(ok, _mm_cmple_ps(r2, max4));
           const __m128 el = elevation_deg4(z, _mm_sqrt_ps(r2));
-          _mm_store_ps(elevation, _mm_or_ps(_mm_and_ps(ok, el), _mm_andnot_ps(ok, outside)));
+          _mm_store_ps(elevation, select_ps(ok, el, outside));
           const auto assign = [&](int lane) {
             const int ring = ring_from_elevation_deg(model_, elevation[lane]);
             ring_of_[i + lane] = static_cast<std::int16_t>(ring);
