@@ -60,6 +60,24 @@ inline __m128 elevation_deg4(__m128 z, __m128 horizontal_range) {
   a = _mm_or_ps(a, _mm_and_ps(z, sign));  // z < 0: -a (a >= 0; -0 keeps +0's value)
   return _mm_mul_ps(a, _mm_set1_ps(180.0f / static_cast<float>(M_PI)));
 }
+
+// ring_from_elevation_hdl64_deg of four elevations: the same float operations in the same
+// order, so each lane equals the scalar ring.
+inline __m128i hdl64_rings4(__m128 a) {
+  const __m128i upper = _mm_cvttps_epi32(_mm_add_ps(
+      _mm_mul_ps(_mm_sub_ps(_mm_set1_ps(2.0f), a), _mm_set1_ps(3.0f)), _mm_set1_ps(0.5f)));
+  const __m128i lower = _mm_add_epi32(
+      _mm_cvttps_epi32(_mm_add_ps(_mm_mul_ps(_mm_sub_ps(_mm_set1_ps(-8.83f), a), _mm_set1_ps(2.0f)),
+                                  _mm_set1_ps(0.5f))),
+      _mm_set1_epi32(32));
+  const __m128i in_upper = _mm_castps_si128(_mm_cmpge_ps(a, _mm_set1_ps(-8.83f)));
+  const __m128i ring = _mm_or_si128(_mm_and_si128(in_upper, upper), _mm_andnot_si128(in_upper, lower));
+  // Inside the field of view (not a > 2, not a < -24.33) and 0 <= ring < 64, else -1.
+  const __m128 outside = _mm_or_ps(_mm_cmpgt_ps(a, _mm_set1_ps(2.0f)), _mm_cmplt_ps(a, _mm_set1_ps(-24.33f)));
+  __m128i valid = _mm_andnot_si128(_mm_castps_si128(outside), _mm_cmpgt_epi32(ring, _mm_set1_epi32(-1)));
+  valid = _mm_and_si128(valid, _mm_cmplt_epi32(ring, _mm_set1_epi32(64)));
+  return _mm_or_si128(_mm_and_si128(valid, ring), _mm_andnot_si128(valid, _mm_set1_epi32(-1)));
+}
 #endif
 
 }  // namespace
@@ -235,7 +253,17 @@ void FeatureExtractor::assign_rings(const std::vector<LidarPoint>& points, bool 
           ok = _mm_and_ps(ok, _mm_and_ps(_mm_cmpgt_ps(r2, zero), _mm_cmpge_ps(r2, min4)));
           ok = _mm_and_ps(ok, _mm_cmple_ps(r2, max4));
           const __m128 el = elevation_deg4(z, _mm_sqrt_ps(r2));
-          _mm_store_ps(elevation, select_ps(ok, el, outside));
+          const __m128 a = select_ps(ok, el, outside);
+          if (model_ == LidarModel::hdl64) {
+            alignas(16) int rings[4];
+            _mm_store_si128(reinterpret_cast<__m128i*>(rings), hdl64_rings4(a));
+            for (int lane = 0; lane < 4; ++lane) {
+              ring_of_[i + lane] = static_cast<std::int16_t>(rings[lane]);
+              ++local[static_cast<std::size_t>(rings[lane] + 1)];
+            }
+            continue;
+          }
+          _mm_store_ps(elevation, a);
           const auto assign = [&](int lane) {
             const int ring = ring_from_elevation_deg(model_, elevation[lane]);
             ring_of_[i + lane] = static_cast<std::int16_t>(ring);
@@ -255,8 +283,10 @@ void FeatureExtractor::assign_rings(const std::vector<LidarPoint>& points, bool 
           if (use_ring_field) {
             ring = (p.ring >= 0 && p.ring < beams_) ? p.ring : -1;
           } else {
-            ring = static_cast<std::int16_t>(
-                ring_from_elevation_deg(model_, elevation_deg(p.z, std::sqrt(r2))));
+            const float a = elevation_deg(p.z, std::sqrt(r2));
+            ring = static_cast<std::int16_t>(model_ == LidarModel::hdl64
+                                                 ? ring_from_elevation_hdl64_deg(a)
+                                                 : ring_from_elevation_deg(model_, a));
           }
         }
         ring_of_[i] = ring;
@@ -326,17 +356,25 @@ void FeatureExtractor::select_in_ring(int ring) {
   std::fill(unreliable, unreliable + n, 0);
   if (feat_.reject_occluded) {
     // LOAM's occlusion test: at a depth jump between neighbours seen at the same bearing, the
-    // far side's points are hidden or revealed as the sensor moves: never edges.
+    // far side's points are hidden or revealed as the sensor moves: never edges. LOAM's test,
+    // |q - p d_q / d_p| / d_q < ratio for the far point p and the near q (either way round),
+    // is |p / d_p - q / d_q| < ratio: the two bearings lie within an angle whose chord is
+    // `ratio`, i.e. p.q > (1 - ratio^2 / 2) d_p d_q. Squared, it needs no root or division.
     const float ratio = static_cast<float>(feat_.occlusion_gap_ratio);
+    const float cos_min = 1.0f - 0.5f * ratio * ratio;
+    const float cos_min2 = cos_min * cos_min;
+    const bool wide = !(cos_min > 0);  // ratio >= sqrt(2): the chord test passes any p.q > -...
     for (int i = hw; i < n - hw - 1; ++i) {
       if ((p[i + 1] - p[i]).squaredNorm() <= 0.1f) continue;
-      const float d1 = p[i].norm(), d2 = p[i + 1].norm();
-      if (d1 > d2) {
-        if ((p[i + 1] - p[i] * (d2 / d1)).norm() / d2 < ratio)
-          for (int k = std::max(0, i - hw); k <= i; ++k) unreliable[k] = 1;
+      const float dot = p[i].dot(p[i + 1]);
+      const float n1 = p[i].squaredNorm(), n2 = p[i + 1].squaredNorm();
+      const bool same_bearing = wide ? dot > cos_min * std::sqrt(n1 * n2)
+                                     : dot > 0 && dot * dot > cos_min2 * (n1 * n2);
+      if (!same_bearing) continue;
+      if (n1 > n2) {
+        for (int k = std::max(0, i - hw); k <= i; ++k) unreliable[k] = 1;
       } else {
-        if ((p[i + 1] * (d1 / d2) - p[i]).norm() / d1 < ratio)
-          for (int k = i + 1; k <= std::min(n - 1, i + hw + 1); ++k) unreliable[k] = 1;
+        for (int k = i + 1; k <= std::min(n - 1, i + hw + 1); ++k) unreliable[k] = 1;
       }
     }
   }
@@ -353,6 +391,10 @@ void FeatureExtractor::select_in_ring(int ring) {
   const int sectors = feat_.sectors_per_ring;
   const int usable = n - 2 * hw;
   std::vector<int>& cand = candidates_[ring];
+  // Plane points are written without a branch: every point goes in, the count advances only
+  // for the ones not picked as (or next to) an edge.
+  planes.resize(static_cast<std::size_t>(usable));
+  std::size_t plane_count = 0;
   for (int s = 0; s < sectors; ++s) {
     const int sb = hw + usable * s / sectors, se = hw + usable * (s + 1) / sectors;
     // Candidates without a branch per point: every index is written, the count advances
@@ -388,9 +430,12 @@ void FeatureExtractor::select_in_ring(int ring) {
         picked[i - k] = 1;
       }
     }
-    for (int i = sb; i < se; ++i)
-      if (!picked[i]) planes.push_back(p[i]);
+    for (int i = sb; i < se; ++i) {
+      planes[plane_count] = p[i];
+      plane_count += static_cast<std::size_t>(!picked[i]);
+    }
   }
+  planes.resize(plane_count);
   correct_elevation(edges, pre_.elevation_correction_deg);
   correct_elevation(planes, pre_.elevation_correction_deg);
 }
@@ -411,14 +456,25 @@ void FeatureExtractor::extract(const std::vector<LidarPoint>& points, bool use_r
       select_in_ring(r);
     }
   });
-  for (int r = 0; r < beams_; ++r) stats_.rings_resorted += ring_resorted_[r];
-  edges.clear();
-  planes.clear();
+  // Rings concatenated in ring order, each copied in parallel to its place.
+  std::vector<std::size_t>& edge_at = concat_edges_;
+  std::vector<std::size_t>& plane_at = concat_planes_;
+  edge_at.assign(static_cast<std::size_t>(beams_) + 1, 0);
+  plane_at.assign(static_cast<std::size_t>(beams_) + 1, 0);
   for (int r = 0; r < beams_; ++r) {
+    stats_.rings_resorted += ring_resorted_[r];
     if (!ring_edges_[r].empty() || !ring_planes_[r].empty()) ++stats_.rings_used;
-    edges.insert(edges.end(), ring_edges_[r].begin(), ring_edges_[r].end());
-    planes.insert(planes.end(), ring_planes_[r].begin(), ring_planes_[r].end());
+    edge_at[r + 1] = edge_at[r] + ring_edges_[r].size();
+    plane_at[r + 1] = plane_at[r] + ring_planes_[r].size();
   }
+  edges.resize(edge_at[beams_]);
+  planes.resize(plane_at[beams_]);
+  tbb::parallel_for(tbb::blocked_range<int>(0, beams_, 4), [&](const auto& range) {
+    for (int r = range.begin(); r != range.end(); ++r) {
+      std::copy(ring_edges_[r].begin(), ring_edges_[r].end(), edges.begin() + static_cast<std::ptrdiff_t>(edge_at[r]));
+      std::copy(ring_planes_[r].begin(), ring_planes_[r].end(), planes.begin() + static_cast<std::ptrdiff_t>(plane_at[r]));
+    }
+  });
 }
 
 }  // namespace scfloam

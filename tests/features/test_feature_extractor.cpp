@@ -138,6 +138,47 @@ TEST(FeatureExtractor, CornerSceneEdgesOnTheCornersPlanesOnTheWalls) {
   EXPECT_LE(edges.size(), 64u * 6u * 20u);
 }
 
+// LOAM's occlusion test: where a near wall ends in front of a far one, the far wall's points
+// next to the depth jump (on either side of the near wall) are never edges; without the test
+// they are the strongest edges of their sector.
+std::vector<LidarPoint> wall_behind_wall_scan() {
+  std::vector<LidarPoint> pts;
+  for (int ring = 0; ring < 64; ++ring) {
+    const double elev = (1.0 - ring * 0.2) * M_PI / 180.0;  // near level: walls, no ground
+    for (int k = 0; k < 450; ++k) {  // 0.2 deg steps over 90 deg
+      const double az = k * 0.2 * M_PI / 180.0;
+      const Eigen::Vector3d dir(std::cos(elev) * std::cos(az), std::cos(elev) * std::sin(az), std::sin(elev));
+      const bool far = k >= 150 && k < 300;  // the near wall x = 10 has a gap from 30 to 60 deg
+      pts.push_back(ring_point((far ? 30.0 : 10.0) / dir.x() * dir, ring));
+    }
+  }
+  return pts;
+}
+
+int far_edges_next_to_the_jumps(bool reject_occluded) {
+  OdometryConfig c;
+  c.preprocess.max_range_m = 100;
+  c.preprocess.elevation_correction_deg = 0;
+  c.features.reject_occluded = reject_occluded;
+  FeatureExtractor extractor(c.preprocess, c.rings, c.features);
+  FeatureCloud edges, planes;
+  extractor.extract(wall_behind_wall_scan(), /*use_ring_field=*/true, edges, planes);
+  const int hw = c.features.curvature_half_window;
+  int count = 0;
+  for (const auto& e : edges) {
+    if (std::abs(e.x() - 30.0f) > 0.01f) continue;  // not on the far wall
+    const double az_deg = std::atan2(e.y(), e.x()) * 180.0 / M_PI;
+    const double margin = (hw + 1) * 0.2 + 0.01;
+    count += (az_deg - 30.0 < margin) || (60.0 - az_deg < margin);
+  }
+  return count;
+}
+
+TEST(FeatureExtractor, OcclusionTestKeepsEdgesOffTheFarSideOfADepthJump) {
+  EXPECT_EQ(far_edges_next_to_the_jumps(true), 0);
+  EXPECT_GE(far_edges_next_to_the_jumps(false), 64);  // at least one per ring without the test
+}
+
 // The elevation correction is applied to the selected features, after ring assignment and
 // selection: the same features as without it, each rotated up in its own vertical plane.
 TEST(FeatureExtractor, ElevationCorrectionRotatesTheSelectedFeaturesUp) {

@@ -66,6 +66,7 @@ class FeatureExtractor {
   std::vector<char> ring_resorted_;                            // per ring, last extract()
   std::vector<std::vector<std::pair<float, int>>> sort_scratch_;  // per ring
   std::vector<FeatureCloud> ring_copy_;                        // per ring
+  std::vector<std::size_t> concat_edges_, concat_planes_;      // per ring: output offsets
   FeatureStats stats_;
 };
 

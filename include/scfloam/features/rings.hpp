@@ -49,4 +49,15 @@ inline int ring_from_elevation_deg(LidarModel model, double a) {
   return static_cast<int>(std::floor(pos + 0.5));
 }
 
+// ring_from_elevation_deg's HDL-64E table in float arithmetic, for the feature step: the SSE2
+// lanes of its ring assignment do these same float operations in this order, so a point gets
+// the same ring in a lane or in the scalar tail. It differs from the double version only for
+// elevations within float rounding (~1e-6 deg) of a boundary between two beams.
+inline int ring_from_elevation_hdl64_deg(float a) {
+  if (a > 2.0f || a < -24.33f) return -1;
+  const int ring = a >= -8.83f ? static_cast<int>((2.0f - a) * 3.0f + 0.5f)
+                               : 32 + static_cast<int>((-8.83f - a) * 2.0f + 0.5f);
+  return ring >= 0 && ring < 64 ? ring : -1;
+}
+
 }  // namespace scfloam
