@@ -131,6 +131,10 @@ struct PipelineConfig {
   // output (tests, evaluation). Otherwise the stages run on their own threads.
   bool deterministic = false;
   int queue_capacity = 256;        // keyframes waiting between stages
+  // The loop detection and closure threads run this much nicer (0-19) than the odometry, so
+  // that when both want the two cores the odometry gets them and the loop stages catch up in
+  // its idle time (the queues above give them hundreds of keyframes of slack).
+  int loop_thread_nice = 10;
   // While keyframes wait for the closure stage, an accepted loop's graph solve waits too, for
   // at most this many loops: the backlog is worked off and solved once (a whole-graph solve
   // per loop is slower than real time on graphs of thousands of keyframes). 0: solve after

@@ -137,6 +137,7 @@ std::vector<Binding> bindings(SlamConfig& c) {
       {pl, "deterministic", &p.deterministic},
       {pl, "queue_capacity", &p.queue_capacity},
       {pl, "max_deferred_loops", &p.max_deferred_loops},
+      {pl, "loop_thread_nice", &p.loop_thread_nice},
       {pl, "rebuild_map_after_loop", &p.rebuild_map_after_loop},
       {pl, "map_rebuild_min_shift_m", &p.map_rebuild_min_shift_m},
       {pl, "raw_leaf_m", &p.raw_leaf_m},
@@ -235,6 +236,8 @@ void check_ranges(const SlamConfig& c, const std::filesystem::path& path) {
   require(c.loop_registration.icp_leaf_m > 0, "loop_registration.icp_leaf_m", "> 0");
   require(c.pipeline.queue_capacity >= 1, "pipeline.queue_capacity", ">= 1");
   require(c.pipeline.max_deferred_loops >= 0, "pipeline.max_deferred_loops", ">= 0");
+  require(c.pipeline.loop_thread_nice >= 0 && c.pipeline.loop_thread_nice <= 19,
+          "pipeline.loop_thread_nice", "in 0..19");
   require(c.pipeline.raw_leaf_m > 0, "pipeline.raw_leaf_m", "> 0");
   require(c.pipeline.resident_keyframes >= 0, "pipeline.resident_keyframes", ">= 0");
   require(c.pipeline.map_rebuild_cell_m >= 0, "pipeline.map_rebuild_cell_m", ">= 0");

@@ -24,6 +24,7 @@
 #include "scfloam/registration/voxel_filter.hpp"
 #include "scfloam/se3.hpp"
 #include "scfloam/stats.hpp"
+#include "scfloam/thread_priority.hpp"
 
 namespace scfloam {
 namespace {
@@ -121,9 +122,10 @@ class DetectionStage {
 class LoopThreads {
  public:
   LoopThreads(DetectionStage& detection, LoopClosure& closure, const KeyframeStore& store,
-              int capacity, LiveCounters* live)
+              int capacity, int nice, LiveCounters* live)
       : to_detection_(capacity), to_closure_(capacity), live_(live) {
-    detection_thread_ = std::thread([this, &detection] {
+    detection_thread_ = std::thread([this, &detection, nice] {
+      lower_current_thread_priority(nice);
       guarded([&] {
         while (auto kf = to_detection_.pop()) {
           report_depths();
@@ -133,7 +135,8 @@ class LoopThreads {
       });
       to_closure_.close();
     });
-    closure_thread_ = std::thread([this, &closure, &store] {
+    closure_thread_ = std::thread([this, &closure, &store, nice] {
+      lower_current_thread_priority(nice);
       guarded([&] {
         while (auto item = to_closure_.pop()) {
           report_depths();
@@ -355,7 +358,8 @@ RunResult run_slam(const ScanSource& source, const SlamConfig& base_config,
   });
   std::optional<LoopThreads> threads;
   if (loops && !deterministic)
-    threads.emplace(detection, closure, store, config.pipeline.queue_capacity, options.live);
+    threads.emplace(detection, closure, store, config.pipeline.queue_capacity,
+                    config.pipeline.loop_thread_nice, options.live);
 
   ScanPrefetcher prefetcher(source, count);
   ProgressBar progress(mode_name(options.mode), count, options.progress);
