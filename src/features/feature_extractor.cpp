@@ -363,7 +363,8 @@ void FeatureExtractor::select_in_ring(int ring) {
     const float ratio = static_cast<float>(feat_.occlusion_gap_ratio);
     const float cos_min = 1.0f - 0.5f * ratio * ratio;
     const float cos_min2 = cos_min * cos_min;
-    const bool wide = !(cos_min > 0);  // ratio >= sqrt(2): the chord test passes any p.q > -...
+    // ratio >= sqrt(2) makes cos_min <= 0, where squaring would lose the sign: use the roots.
+    const bool wide = !(cos_min > 0);
     for (int i = hw; i < n - hw - 1; ++i) {
       if ((p[i + 1] - p[i]).squaredNorm() <= 0.1f) continue;
       const float dot = p[i].dot(p[i + 1]);
