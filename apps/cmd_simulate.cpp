@@ -74,6 +74,15 @@ scfloam::cli::RegisterCommand reg("simulate", [](CLI::App& app) {
       ->check(CLI::Range(0.0, 0.9));
   sub->add_option("--elevation-bias", args->config.elevation_bias_deg,
                   "Common elevation error of all beams in degrees (default: the sensor's; hdl64 0.205 as KITTI)");
+  sub->add_option("--beam-elevation-error", args->config.beam_elevation_error_deg,
+                  "Per-beam elevation calibration error, 1 sigma in degrees (default: the sensor's, 0.02)")
+      ->check(CLI::Range(0.0, 5.0));
+  sub->add_option("--beam-azimuth-error", args->config.beam_azimuth_error_deg,
+                  "Per-beam azimuth calibration error, 1 sigma in degrees (default: the sensor's, 0.02)")
+      ->check(CLI::Range(0.0, 5.0));
+  sub->add_option("--beam-range-bias", args->config.beam_range_bias_m,
+                  "Per-beam range bias, 1 sigma in metres (default: the sensor's, 0.008)")
+      ->check(CLI::Range(0.0, 1.0));
   sub->add_flag("--no-traffic", args->no_traffic, "A static world: no moving cars or pedestrians");
   sub->add_option("--oncoming-per-min", args->config.traffic.oncoming_per_minute, "Oncoming cars passing per minute")
       ->capture_default_str();

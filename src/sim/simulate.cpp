@@ -21,6 +21,9 @@ SensorModel sensor_for(const SimConfig& config) {
   if (config.range_noise_m >= 0) s.range_noise_m = config.range_noise_m;
   if (config.dropout_prob >= 0) s.dropout_prob = config.dropout_prob;
   if (config.elevation_bias_deg > -90) s.elevation_bias_deg = config.elevation_bias_deg;
+  if (config.beam_elevation_error_deg >= 0) s.beam_elevation_error_deg = config.beam_elevation_error_deg;
+  if (config.beam_azimuth_error_deg >= 0) s.beam_azimuth_error_deg = config.beam_azimuth_error_deg;
+  if (config.beam_range_bias_m >= 0) s.beam_range_bias_m = config.beam_range_bias_m;
   return s;
 }
 
@@ -117,6 +120,9 @@ void simulate_sequence(const SimConfig& config, const fs::path& out_dir, bool pr
     out << "range_noise_m: " << sensor.range_noise_m << "\n";
     out << "dropout_prob: " << sensor.dropout_prob << "\n";
     out << "elevation_bias_deg: " << sensor.elevation_bias_deg << "\n";
+    out << "beam_elevation_error_deg: " << sensor.beam_elevation_error_deg << "\n";
+    out << "beam_azimuth_error_deg: " << sensor.beam_azimuth_error_deg << "\n";
+    out << "beam_range_bias_m: " << sensor.beam_range_bias_m << "\n";
     out << "motion_distortion: " << (config.motion_distortion ? "true" : "false") << "\n";
     out << "world:\n  primitives: " << sc.world.primitives.size() << "\n  buildings: " << sc.stats.buildings
         << "\n  trees: " << sc.stats.trees << "\n  poles: " << sc.stats.poles << "\n  cars: " << sc.stats.cars

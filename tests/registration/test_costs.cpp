@@ -85,6 +85,32 @@ TEST(FeatureCosts, HuberFoldedResidualSquaresToRhoAndJacobianMatchesNumeric) {
   }
 }
 
+// huber_delta_m 0 is documented as "no robust loss": the fold must leave the residual and
+// Jacobian as they are (it divided by sqrt(0) before, and every solve failed without a word).
+TEST(FeatureCosts, HuberDeltaZeroIsPlainLeastSquares) {
+  const Eigen::Isometry3d T = some_pose();
+  EdgeMatch m{{3.0, -1.0, 0.5}, T * Eigen::Vector3d(3.0, -0.4, 0.5), Eigen::Vector3d::UnitZ()};
+  Jacobian36 J;
+  Eigen::Vector3d r = edge_residual(m, T.linear(), T.translation(), &J);
+  const Eigen::Vector3d r0 = r;
+  const Jacobian36 J0 = J;
+  robustify_huber<3>(0.0, r, &J);
+  EXPECT_TRUE(r.allFinite());
+  EXPECT_EQ(r, r0);
+  EXPECT_EQ(J, J0);
+  std::vector<EdgeMatch> edges{m};
+  std::vector<PlaneMatch> planes{{{-1, 0, 2}, Eigen::Vector3d::UnitZ(), -3.0}};
+  FeatureCost cost(edges, planes, 0.0);
+  double x[7];
+  pose_to_block(T, x);
+  const double* params[] = {x};
+  double residuals[3], jac[3 * 7];
+  double* jacs[] = {jac};
+  ASSERT_TRUE(cost.Evaluate(params, residuals, jacs));
+  EXPECT_NEAR(std::hypot(residuals[0], residuals[1]), r0.norm(), 1e-12);
+  for (double v : jac) EXPECT_TRUE(std::isfinite(v));
+}
+
 TEST(FeatureCosts, CeresCostEvaluatesEveryMatchWithTangentJacobian) {
   const Eigen::Isometry3d T = some_pose();
   std::vector<EdgeMatch> edges{{{1, 2, 3}, {100, -30, 5}, Eigen::Vector3d::UnitX()}};

@@ -6,6 +6,7 @@
 #include "scfloam/error.hpp"
 #include "scfloam/sim/scan.hpp"
 #include "scfloam/sim/sensor.hpp"
+#include "scfloam/sim/simulate.hpp"
 #include "scfloam/sim/world.hpp"
 
 namespace scfloam::sim {
@@ -161,6 +162,38 @@ TEST(SensorScan, ElevationBiasBendsTheGroundDownWithRange) {
   // At 20 m the beam is ~4.9 deg down: z = -1.73 * sin(4.9) / sin(4.7) ~ -1.80.
   EXPECT_NEAR(mean_z_at(0.205, 19, 21), -1.73 - 20 * std::tan(0.205 * M_PI / 180), 0.02);
   EXPECT_NEAR(mean_z_at(0.205, 4, 6), -1.73 - 5 * std::tan(0.205 * M_PI / 180), 0.01);
+}
+
+// `simulate --beam-elevation-error/--beam-azimuth-error/--beam-range-bias` override the
+// preset's per-beam calibration errors: 0 gives a perfectly calibrated sensor (the common
+// elevation bias stays separate), negative keeps the preset's.
+TEST(SensorScan, BeamCalibrationErrorsFollowTheSimConfig) {
+  SimConfig config;
+  config.sensor = "vlp16";
+  const SensorModel preset = sensor_for(config);
+  EXPECT_GT(preset.beam_elevation_error_deg, 0);
+  EXPECT_GT(preset.beam_range_bias_m, 0);
+  const BeamCalibration drawn = draw_beam_calibration(preset, 4);
+  double spread = 0;
+  for (double v : drawn.range_bias_m) spread += std::abs(v);
+  EXPECT_GT(spread, 0);
+
+  config.beam_elevation_error_deg = config.beam_azimuth_error_deg = config.beam_range_bias_m = 0;
+  const BeamCalibration perfect_sensor = draw_beam_calibration(sensor_for(config), 4);
+  for (int b = 0; b < preset.beams(); ++b) {
+    EXPECT_EQ(perfect_sensor.elevation_offset_rad[b], 0.0) << b;
+    EXPECT_EQ(perfect_sensor.azimuth_offset_rad[b], 0.0) << b;
+    EXPECT_EQ(perfect_sensor.range_bias_m[b], 0.0) << b;
+  }
+
+  config.beam_elevation_error_deg = 0.5;
+  const SensorModel wide = sensor_for(config);
+  EXPECT_DOUBLE_EQ(wide.beam_elevation_error_deg, 0.5);
+  double rms = 0;
+  for (double v : draw_beam_calibration(wide, 4).elevation_offset_rad) rms += v * v;
+  rms = std::sqrt(rms / wide.beams()) * 180 / M_PI;
+  EXPECT_GT(rms, 0.2);  // 16 draws of sigma 0.5 deg
+  EXPECT_LT(rms, 1.0);
 }
 
 }  // namespace

@@ -47,7 +47,7 @@ template <int Rows>
 void robustify_huber(double delta, Eigen::Matrix<double, Rows, 1>& r,
                      Eigen::Matrix<double, Rows, 6>* J) {
   const double m = r.norm();
-  if (m <= delta) return;
+  if (delta <= 0 || m <= delta) return;  // delta 0: plain least squares (no loss)
   const double rho = 2 * delta * m - delta * delta;
   const double g = std::sqrt(rho) / m;      // scale perpendicular to r
   const double a = delta / std::sqrt(rho);  // d|r~|/d|r| along r

@@ -31,6 +31,10 @@ struct SimConfig {
   double range_noise_m = -1;
   double dropout_prob = -1;
   double elevation_bias_deg = -1e9;  // below -90: keep the preset's (hdl64: KITTI's 0.205)
+  // Per-beam calibration errors, 1 sigma (negative = the preset's: 0.02 deg, 0.02 deg, 8 mm).
+  double beam_elevation_error_deg = -1;
+  double beam_azimuth_error_deg = -1;
+  double beam_range_bias_m = -1;
   TrafficConfig traffic;  // moving cars and pedestrians (on by default)
   bool facade_detail = true;  // recessed windows, ledges, glass on building walls
 };
