@@ -30,7 +30,18 @@ sim_args() {
     city-loops-short) echo "--frames 1000 --seed 1 --route loops" ;;
     kitti00) echo "--replay $shared/data/kitti/ground-truth/poses/00.txt --seed 2" ;;
     kitti05) echo "--replay $shared/data/kitti/ground-truth/poses/05.txt --seed 3" ;;
+    # A VLP-16 city loop: sparse rings make the odometry drift about as much as F-LOAM does on
+    # real KITTI (0.8 %), the regime of the paper's Table I (docs/loop_closure.md, session 11).
+    vlp16-loops) echo "--sensor vlp16 --frames 1500 --seed 5 --route loops" ;;
     *) echo "unknown sequence $1" >&2; exit 1 ;;
+  esac
+}
+
+# name -> extra `scfloam run` arguments (the sensor's preset)
+run_args() {
+  case "$1" in
+    vlp16-loops) echo "--sensor vlp16" ;;
+    *) echo "" ;;
   esac
 }
 
@@ -52,7 +63,8 @@ for entry in $sequences; do
     rm -rf "$results"/run-"$seq"-"$mode"-*
     for r in $(seq 1 "$runs"); do
       echo "== $seq $mode run $r/$runs"
-      "$bin/scfloam" run "$dir" --mode "$mode" --out "$results/run-$seq-$mode-$r" --force --quiet > /dev/null
+      # shellcheck disable=SC2046
+      "$bin/scfloam" run "$dir" $(run_args "$seq") --mode "$mode" --out "$results/run-$seq-$mode-$r" --force --quiet > /dev/null
     done
   done
 done
