@@ -85,6 +85,15 @@ TEST(FeatureCosts, HuberFoldedResidualSquaresToRhoAndJacobianMatchesNumeric) {
   }
 }
 
+// Evaluates a FeatureCost at pose T: residuals and the row-major 7-column Jacobian.
+bool evaluate_at(const FeatureCost& cost, const Eigen::Isometry3d& T, double* residuals, double* jacobian) {
+  double x[7];
+  pose_to_block(T, x);
+  const double* params[] = {x};
+  double* jacobians[] = {jacobian};
+  return cost.Evaluate(params, residuals, jacobians);
+}
+
 // huber_delta_m 0 is documented as "no robust loss": the fold must leave the residual and
 // Jacobian as they are (it divided by sqrt(0) before, and every solve failed without a word).
 TEST(FeatureCosts, HuberDeltaZeroIsPlainLeastSquares) {
@@ -101,12 +110,8 @@ TEST(FeatureCosts, HuberDeltaZeroIsPlainLeastSquares) {
   std::vector<EdgeMatch> edges{m};
   std::vector<PlaneMatch> planes{{{-1, 0, 2}, Eigen::Vector3d::UnitZ(), -3.0}};
   FeatureCost cost(edges, planes, 0.0);
-  double x[7];
-  pose_to_block(T, x);
-  const double* params[] = {x};
   double residuals[3], jac[3 * 7];
-  double* jacs[] = {jac};
-  ASSERT_TRUE(cost.Evaluate(params, residuals, jacs));
+  ASSERT_TRUE(evaluate_at(cost, T, residuals, jac));
   EXPECT_NEAR(std::hypot(residuals[0], residuals[1]), r0.norm(), 1e-12);
   for (double v : jac) EXPECT_TRUE(std::isfinite(v));
 }
@@ -117,12 +122,8 @@ TEST(FeatureCosts, CeresCostEvaluatesEveryMatchWithTangentJacobian) {
   std::vector<PlaneMatch> planes{{{-1, 0, 2}, Eigen::Vector3d::UnitZ(), -3.0}};
   FeatureCost cost(edges, planes, 0.1);
   ASSERT_EQ(cost.num_residuals(), 3);  // two rows per edge, one per plane
-  double x[7];
-  pose_to_block(T, x);
-  const double* params[] = {x};
   double residuals[3], jac[3 * 7];
-  double* jacs[] = {jac};
-  ASSERT_TRUE(cost.Evaluate(params, residuals, jacs));
+  ASSERT_TRUE(evaluate_at(cost, T, residuals, jac));
   // Edge: the two rows carry the robustified point-to-line vector's norm and its J^T J.
   Jacobian36 Je;
   Eigen::Vector3d re = edge_residual(edges[0], T.linear(), T.translation(), &Je);
