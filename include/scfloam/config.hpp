@@ -131,6 +131,12 @@ struct PipelineConfig {
   // output (tests, evaluation). Otherwise the stages run on their own threads.
   bool deterministic = false;
   int queue_capacity = 256;        // keyframes waiting between stages
+  // The odometry waits before scan f until the loop stages have finished every keyframe made
+  // before scan f - max_loop_lag_frames: corrections then reach its map as they would live,
+  // where a 10 Hz sensor gives the loop stages 100 ms per scan. Without the bound, a file read
+  // at 8x real time leaves the loop stages keyframes behind and the odometry drifts on an
+  // uncorrected map (docs/loop_closure.md). -1: never wait (only a full queue blocks).
+  int max_loop_lag_frames = 1;
   // The loop detection and closure threads run this much nicer (0-19) than the odometry, so
   // that when both want the two cores the odometry gets them and the loop stages catch up in
   // its idle time (the queues above give them hundreds of keyframes of slack).

@@ -136,6 +136,7 @@ std::vector<Binding> bindings(SlamConfig& c) {
   table.insert(table.end(), {
       {pl, "deterministic", &p.deterministic},
       {pl, "queue_capacity", &p.queue_capacity},
+      {pl, "max_loop_lag_frames", &p.max_loop_lag_frames},
       {pl, "max_deferred_loops", &p.max_deferred_loops},
       {pl, "loop_thread_nice", &p.loop_thread_nice},
       {pl, "rebuild_map_after_loop", &p.rebuild_map_after_loop},
@@ -235,6 +236,7 @@ void check_ranges(const SlamConfig& c, const std::filesystem::path& path) {
   require(d.gate_drift_fraction >= 0, "loop_detection.gate_drift_fraction", ">= 0");
   require(c.loop_registration.icp_leaf_m > 0, "loop_registration.icp_leaf_m", "> 0");
   require(c.pipeline.queue_capacity >= 1, "pipeline.queue_capacity", ">= 1");
+  require(c.pipeline.max_loop_lag_frames >= -1, "pipeline.max_loop_lag_frames", ">= -1");
   require(c.pipeline.max_deferred_loops >= 0, "pipeline.max_deferred_loops", ">= 0");
   require(c.pipeline.loop_thread_nice >= 0 && c.pipeline.loop_thread_nice <= 19,
           "pipeline.loop_thread_nice", "in 0..19");

@@ -6,8 +6,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <condition_variable>
 #include <cstdio>
 #include <exception>
+#include <mutex>
 #include <thread>
 #include <unordered_set>
 #include <utility>
@@ -122,8 +124,8 @@ class DetectionStage {
 class LoopThreads {
  public:
   LoopThreads(DetectionStage& detection, LoopClosure& closure, const KeyframeStore& store,
-              int capacity, int nice, LiveCounters* live)
-      : to_detection_(capacity), to_closure_(capacity), live_(live) {
+              int capacity, int nice, int max_lag, LiveCounters* live)
+      : to_detection_(capacity), to_closure_(capacity), max_lag_(max_lag), live_(live) {
     detection_thread_ = std::thread([this, &detection, nice] {
       lower_current_thread_priority(nice);
       guarded([&] {
@@ -144,6 +146,11 @@ class LoopThreads {
           const bool backlog = to_closure_.size() > 0;
           closure.add(item->keyframe, item->query, backlog);
           if (!backlog) closure.solve_deferred();  // caught up: one solve for the waiting loops
+          {
+            std::lock_guard<std::mutex> lock(lag_mutex_);
+            ++closed_;
+          }
+          lag_changed_.notify_all();
         }
       });
     });
@@ -151,8 +158,23 @@ class LoopThreads {
   ~LoopThreads() { finish(); }
 
   void push(KeyframePtr kf) {
+    {
+      std::lock_guard<std::mutex> lock(lag_mutex_);
+      pushed_frames_.push_back(kf->frame);
+    }
     to_detection_.push(std::move(kf));
     report_depths();
+  }
+  // Before the odometry processes scan `frame`: waits until every keyframe made before scan
+  // frame - max_lag has been through loop closure (no wait when max_lag < 0).
+  void wait_for_lag(std::size_t frame) {
+    if (max_lag_ < 0) return;
+    std::unique_lock<std::mutex> lock(lag_mutex_);
+    lag_changed_.wait(lock, [&] {
+      return stopped_ || closed_ == pushed_frames_.size() ||
+             static_cast<std::int64_t>(pushed_frames_[closed_]) + max_lag_ >=
+                 static_cast<std::int64_t>(frame);
+    });
   }
   // Waits for every keyframe to be handled; rethrows a stage's error.
   void finish() {
@@ -174,16 +196,29 @@ class LoopThreads {
     try {
       work();
     } catch (...) {
-      std::lock_guard<std::mutex> lock(error_mutex_);
-      if (!error_) error_ = std::current_exception();
+      {
+        std::lock_guard<std::mutex> lock(error_mutex_);
+        if (!error_) error_ = std::current_exception();
+      }
       to_detection_.close();
       to_closure_.close();
+      {
+        std::lock_guard<std::mutex> lock(lag_mutex_);
+        stopped_ = true;  // a waiting push goes on, into a closed queue
+      }
+      lag_changed_.notify_all();
     }
   }
 
   BoundedQueue<KeyframePtr> to_detection_;
   BoundedQueue<DetectedKeyframe> to_closure_;
+  std::int64_t max_lag_;  // frames (pipeline.max_loop_lag_frames)
   LiveCounters* live_;
+  std::mutex lag_mutex_;  // guards the three below
+  std::condition_variable lag_changed_;
+  std::vector<std::size_t> pushed_frames_;  // scan index of every keyframe handed over
+  std::size_t closed_ = 0;                  // keyframes the closure stage has finished
+  bool stopped_ = false;                    // a stage failed
   std::thread detection_thread_, closure_thread_;
   std::mutex error_mutex_;
   std::exception_ptr error_;
@@ -359,17 +394,25 @@ RunResult run_slam(const ScanSource& source, const SlamConfig& base_config,
   std::optional<LoopThreads> threads;
   if (loops && !deterministic)
     threads.emplace(detection, closure, store, config.pipeline.queue_capacity,
-                    config.pipeline.loop_thread_nice, options.live);
+                    config.pipeline.loop_thread_nice,
+                    config.pipeline.max_loop_lag_frames, options.live);
 
   ScanPrefetcher prefetcher(source, count);
   ProgressBar progress(mode_name(options.mode), count, options.progress);
-  // Where the odometry thread waits: for the next scan, and for room in the loop queue.
+  // Where the odometry thread waits: for the next scan, for the loop stages to catch up, and
+  // for room in the loop queue.
   std::vector<double>& wait_input_ms = result.timing_ms["wait_input"];
   std::vector<double>& wait_queue_ms = result.timing_ms["wait_loop_queue"];
+  std::vector<double>& wait_lag_ms = result.timing_ms["wait_loop_lag"];
   Stopwatch waiting;
   while (auto item = prefetcher.next()) {
     wait_input_ms.push_back(waiting.elapsed_ms());
     const auto& [index, scan] = *item;
+    if (threads) {
+      Stopwatch lag_watch;
+      threads->wait_for_lag(index);
+      wait_lag_ms.push_back(lag_watch.elapsed_ms());
+    }
     KeyframePtr kf = odometry.process(index, scan, result);
     if (kf && options.live) options.live->keyframes.fetch_add(1, std::memory_order_relaxed);
     if (kf && loops) {
@@ -400,6 +443,7 @@ RunResult run_slam(const ScanSource& source, const SlamConfig& base_config,
   if (loops) closure.finish();
   progress.finish();
   if (wait_queue_ms.empty()) result.timing_ms.erase("wait_loop_queue");
+  if (wait_lag_ms.empty()) result.timing_ms.erase("wait_loop_lag");
 
   result.keyframe_poses = store.current_poses();
   result.T_world_lidar = odometry.final_poses(result.keyframe_poses);

@@ -150,6 +150,7 @@ TEST(BadInput, ConfigValuesOutOfRangeNameTheKey) {
       {"odometry:\n  registration:\n    max_neighbor_dist_m: .nan\n",
        "odometry.registration.max_neighbor_dist_m"},
       {"loop_detection:\n  descriptor:\n    num_sectors: 0\n", "loop_detection.descriptor.num_sectors"},
+      {"pipeline:\n  max_loop_lag_frames: -2\n", "pipeline.max_loop_lag_frames"},
   };
   for (std::size_t i = 0; i < cases.size(); ++i) {
     const auto path = dir / ("case" + std::to_string(i) + ".yaml");
