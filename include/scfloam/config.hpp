@@ -59,6 +59,9 @@ struct RegistrationConfig {
   double max_neighbor_dist_m = 1.0;  // the k-th neighbour must lie within this
   double edge_line_ratio = 3.0;      // largest covariance eigenvalue > ratio * second
   double plane_max_dist_m = 0.2;     // every neighbour within this of the fitted plane
+  // Reject a plane match whose neighbours spread along one line only (second covariance
+  // eigenvalue < ratio * largest): a single ring's trace fits any plane through it (0 = off).
+  double plane_min_spread_ratio = 0.0;
   double huber_delta_m = 0.1;
   int inner_iterations = 4;          // Ceres iterations per correspondence round
   int outer_iterations = 2;          // correspondence rounds per frame in steady state

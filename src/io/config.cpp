@@ -50,6 +50,7 @@ std::vector<Binding> bindings(SlamConfig& c) {
       {reg, "max_neighbor_dist_m", &o.registration.max_neighbor_dist_m},
       {reg, "edge_line_ratio", &o.registration.edge_line_ratio},
       {reg, "plane_max_dist_m", &o.registration.plane_max_dist_m},
+      {reg, "plane_min_spread_ratio", &o.registration.plane_min_spread_ratio},
       {reg, "huber_delta_m", &o.registration.huber_delta_m},
       {reg, "inner_iterations", &o.registration.inner_iterations},
       {reg, "outer_iterations", &o.registration.outer_iterations},
@@ -208,6 +209,8 @@ void check_ranges(const SlamConfig& c, const std::filesystem::path& path) {
   require(o.features.edge_leaf_m > 0, "odometry.features.edge_leaf_m", "> 0");
   require(o.features.plane_leaf_m > 0, "odometry.features.plane_leaf_m", "> 0");
   require(o.registration.knn >= 1, "odometry.registration.knn", ">= 1");
+  require(o.registration.plane_min_spread_ratio >= 0 && o.registration.plane_min_spread_ratio < 1,
+          "odometry.registration.plane_min_spread_ratio", "in [0, 1)");
   require(o.registration.max_neighbor_dist_m > 0, "odometry.registration.max_neighbor_dist_m", "> 0");
   require(o.registration.inner_iterations >= 1, "odometry.registration.inner_iterations", ">= 1");
   require(o.registration.outer_iterations >= 1, "odometry.registration.outer_iterations", ">= 1");

@@ -138,6 +138,7 @@ void ScanToMapRegistration::find_matches(const FeatureCloud& edges, const Featur
         map.planes().knn(q, k, radius, nb);
         if (nb.count < k) continue;
         const LocalShape s = local_shape(nb);
+        if (s.eigenvalues[1] < config_.plane_min_spread_ratio * s.eigenvalues[2]) continue;
         const Eigen::Vector3d n = s.eigenvectors.col(0);
         const double offset = -n.dot(s.mean);
         bool flat = true;

@@ -151,6 +151,8 @@ TEST(BadInput, ConfigValuesOutOfRangeNameTheKey) {
        "odometry.registration.max_neighbor_dist_m"},
       {"loop_detection:\n  descriptor:\n    num_sectors: 0\n", "loop_detection.descriptor.num_sectors"},
       {"pipeline:\n  max_loop_lag_frames: -2\n", "pipeline.max_loop_lag_frames"},
+      {"odometry:\n  registration:\n    plane_min_spread_ratio: 1\n",
+       "odometry.registration.plane_min_spread_ratio"},
   };
   for (std::size_t i = 0; i < cases.size(); ++i) {
     const auto path = dir / ("case" + std::to_string(i) + ".yaml");

@@ -77,5 +77,37 @@ TEST(ScanToMap, FlatGroundOnlyIsDegenerate) {
   EXPECT_LT(std::abs(r.weakest_translation_dir.z()), 1e-6);
 }
 
+TEST(ScanToMap, PlaneSpreadRatioRejectsARingTraceButKeepsTheGround) {
+  // A sparse sensor's ring crosses a far facade or a tree crown as one row of points: any plane
+  // through the row fits it, so the match's normal is arbitrary. The ground is a true plane.
+  FeatureCloud ground, traces;
+  for (int i = -10; i <= 10; ++i)
+    for (int j = -10; j <= 10; ++j) ground.emplace_back(0.3f * i, 0.3f * j, -1.7f);
+  for (int row = 0; row < 4; ++row) {  // arcs of one ring's cone, 3 m apart in range
+    const double r = 15.0 + 3.0 * row;
+    for (int i = -20; i <= 20; ++i) {
+      const double a = 0.3 * i / r;  // 0.3 m apart along the arc
+      traces.emplace_back(static_cast<float>(r * std::cos(a)), static_cast<float>(r * std::sin(a)),
+                          static_cast<float>(0.1 * r));
+    }
+  }
+  FeatureCloud planes = ground;
+  planes.insert(planes.end(), traces.begin(), traces.end());
+  OdometryConfig c;
+  c.map.plane_spacing_m = 0.0;  // keep every point: the neighbourhoods are the ones built here
+  FeatureMap map(c.registration, c.map);
+  map.insert({}, planes, Eigen::Isometry3d::Identity());
+  auto plane_matches = [&](double ratio) {
+    c.registration.plane_min_spread_ratio = ratio;
+    return register_features({}, planes, map, Eigen::Isometry3d::Identity(), c.registration, 1)
+        .plane_matches;
+  };
+  const int all = plane_matches(0.0), spread = plane_matches(0.2);
+  // Off: the arcs match as planes too (all but their two end points, whose 4th neighbour is
+  // farther than max_neighbor_dist_m).
+  EXPECT_EQ(all, static_cast<int>(planes.size()) - 2 * 4);
+  EXPECT_EQ(spread, static_cast<int>(ground.size()));  // on: only the ground does
+}
+
 }  // namespace
 }  // namespace scfloam
