@@ -6,7 +6,8 @@
 // mean of the result's error over the frames is the bias one frame would add to the drift.
 // Usage: registration_bias SEQ CONFIG.yaml [--frames 100] [--offset -1 ...]
 //                          [--edges-only | --planes-only]
-// Prints one line per offset: mean roll, pitch, yaw (deg) and x, y, z (m) in the lidar frame.
+// Prints one line per offset: mean roll, pitch, yaw (deg) and x, y, z (m) in the lidar frame,
+// and the mean number of edge and plane matches the final round accepted.
 #include <cstdio>
 #include <algorithm>
 #include <cmath>
@@ -29,6 +30,7 @@ namespace {
 struct Bias {
   Eigen::Vector3d rotation_deg = Eigen::Vector3d::Zero();
   Eigen::Vector3d translation_m = Eigen::Vector3d::Zero();
+  double edge_matches = 0, plane_matches = 0;  // mean accepted matches of the final round
   int frames = 0;
 };
 
@@ -47,11 +49,15 @@ Bias measure(const std::vector<FeatureCloud>& edges, const std::vector<FeatureCl
     const Eigen::AngleAxisd error(truth[k].rotation().transpose() * r.T_world_lidar.rotation());
     bias.rotation_deg += error.angle() * error.axis() * 180.0 / M_PI;
     bias.translation_m += truth[k].rotation().transpose() * (r.T_world_lidar.translation() - truth[k].translation());
+    bias.edge_matches += r.edge_matches;
+    bias.plane_matches += r.plane_matches;
     ++bias.frames;
   }
   if (bias.frames > 0) {
     bias.rotation_deg /= bias.frames;
     bias.translation_m /= bias.frames;
+    bias.edge_matches /= bias.frames;
+    bias.plane_matches /= bias.frames;
   }
   return bias;
 }
@@ -90,13 +96,13 @@ int main(int argc, char** argv) {
       edges.push_back(std::move(r.edges));
       planes.push_back(std::move(r.planes));
     }
-    std::printf("offset  frames  roll_deg  pitch_deg  yaw_deg      x_m      y_m      z_m\n");
+    std::printf("offset  frames  roll_deg  pitch_deg  yaw_deg      x_m      y_m      z_m  edge_matches  plane_matches\n");
     for (const int offset : offsets) {
       if (offset == 0) continue;
       const Bias b = measure(edges, planes, truth, config, offset, use_edges, use_planes);
-      std::printf("%6d  %6d  %8.4f  %9.4f  %7.4f  %7.4f  %7.4f  %7.4f\n", offset, b.frames, b.rotation_deg.x(),
-                  b.rotation_deg.y(), b.rotation_deg.z(), b.translation_m.x(), b.translation_m.y(),
-                  b.translation_m.z());
+      std::printf("%6d  %6d  %8.4f  %9.4f  %7.4f  %7.4f  %7.4f  %7.4f  %12.0f  %13.0f\n", offset, b.frames,
+                  b.rotation_deg.x(), b.rotation_deg.y(), b.rotation_deg.z(), b.translation_m.x(),
+                  b.translation_m.y(), b.translation_m.z(), b.edge_matches, b.plane_matches);
     }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "registration_bias: %s\n", e.what());

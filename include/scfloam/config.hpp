@@ -58,7 +58,7 @@ struct RegistrationConfig {
   int knn = 5;
   double max_neighbor_dist_m = 1.0;  // the k-th neighbour must lie within this
   double edge_line_ratio = 3.0;      // largest covariance eigenvalue > ratio * second
-  double plane_max_dist_m = 0.2;     // every neighbour within this of the fitted plane
+  double plane_max_dist_m = 0.1;     // every neighbour within this of the fitted plane (F-LOAM: 0.2)
   // Reject a plane match whose neighbours spread along one line only (second covariance
   // eigenvalue < ratio * largest): a single ring's trace fits any plane through it (0 = off).
   double plane_min_spread_ratio = 0.0;

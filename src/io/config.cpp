@@ -111,6 +111,7 @@ std::vector<Binding> bindings(SlamConfig& c) {
       {lr, "rounds", &l.rounds},
       {lr, "min_inlier_fraction", &l.min_inlier_fraction},
       {lr, "max_mean_residual_m", &l.max_mean_residual_m},
+      {lr, "check_plane_max_dist_m", &l.check_plane_max_dist_m},
       {lr, "information_inflation", &l.information_inflation},
       {lr, "icp_leaf_m", &l.icp_leaf_m},
       {lr, "icp_max_correspondence_m", &l.icp_max_correspondence_m},
@@ -212,6 +213,9 @@ void check_ranges(const SlamConfig& c, const std::filesystem::path& path) {
   require(o.registration.plane_min_spread_ratio >= 0 && o.registration.plane_min_spread_ratio < 1,
           "odometry.registration.plane_min_spread_ratio", "in [0, 1)");
   require(o.registration.max_neighbor_dist_m > 0, "odometry.registration.max_neighbor_dist_m", "> 0");
+  require(o.registration.plane_max_dist_m > 0, "odometry.registration.plane_max_dist_m", "> 0");
+  require(c.loop_registration.check_plane_max_dist_m > 0, "loop_registration.check_plane_max_dist_m",
+          "> 0");
   require(o.registration.inner_iterations >= 1, "odometry.registration.inner_iterations", ">= 1");
   require(o.registration.outer_iterations >= 1, "odometry.registration.outer_iterations", ">= 1");
   require(o.registration.outer_iterations_max >= 0, "odometry.registration.outer_iterations_max", ">= 0");

@@ -128,6 +128,11 @@ LoopMatch register_loop_features(const KeyframeView& current, const LoopSubmap& 
   const Eigen::Isometry3d T_anchor_loop = T_world_anchor.inverse() * T_world_loop;
   ScanToMapRegistration coarse_solver(coarse_registration(config, registration));
   ScanToMapRegistration fine_solver(registration);
+  // Counts the check's matches at the solved pose.
+  RegistrationConfig check_registration = registration;
+  check_registration.plane_max_dist_m = config.check_plane_max_dist_m;
+  const bool separate_check = check_registration.plane_max_dist_m != registration.plane_max_dist_m;
+  ScanToMapRegistration check_solver(check_registration);
   const std::vector<Eigen::Isometry3d> guesses =
       loop_initial_guesses(T_world_loop, current.T_world_lidar, sc_yaw_rad);
   // Attempt 0 (fine_first): the fine stage alone from the pose guess; then coarse to fine from
@@ -147,7 +152,13 @@ LoopMatch register_loop_features(const KeyframeView& current, const LoopSubmap& 
     match.T_loop_current = T_anchor_loop.inverse() * r.T_world_lidar;
     if (config.information_inflation > 0)
       match.information = loop_edge_information(r, T_anchor_loop, config.information_inflation);
-    match.inlier_fraction = static_cast<double>(r.edge_matches + r.plane_matches) / features;
+    int inliers = r.edge_matches + r.plane_matches;
+    if (separate_check) {
+      const auto [edges, planes] =
+          check_solver.count_matches(*current.edges, *current.planes, submap.fine(), r.T_world_lidar);
+      inliers = edges + planes;
+    }
+    match.inlier_fraction = static_cast<double>(inliers) / features;
     match.residual_m = r.mean_residual_m;
     match.accepted = match.inlier_fraction >= config.min_inlier_fraction &&
                      match.residual_m <= config.max_mean_residual_m;

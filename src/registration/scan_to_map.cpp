@@ -163,6 +163,14 @@ void ScanToMapRegistration::find_matches(const FeatureCloud& edges, const Featur
     if (plane_ok_[i]) plane_out_.push_back(plane_all_[i]);
 }
 
+std::pair<int, int> ScanToMapRegistration::count_matches(const FeatureCloud& edges,
+                                                         const FeatureCloud& planes,
+                                                         const FeatureMap& map,
+                                                         const Eigen::Isometry3d& T_world_lidar) {
+  find_matches(edges, planes, map, T_world_lidar, true);
+  return {static_cast<int>(edge_out_.size()), static_cast<int>(plane_out_.size())};
+}
+
 namespace {
 
 using Matrix6 = Eigen::Matrix<double, 6, 6>;

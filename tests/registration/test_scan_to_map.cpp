@@ -109,5 +109,29 @@ TEST(ScanToMap, PlaneSpreadRatioRejectsARingTraceButKeepsTheGround) {
   EXPECT_EQ(spread, static_cast<int>(ground.size()));  // on: only the ground does
 }
 
+TEST(ScanToMap, CountMatchesAtTheSolutionAreAlignsAndFollowTheFlatnessTest) {
+  // A ground grid with a rough strip (every other row 0.25 m up): the strip's neighbourhoods
+  // pass a 0.2 m flatness test and fail a 0.1 m one.
+  FeatureCloud planes;
+  for (int i = -10; i <= 10; ++i)
+    for (int j = -10; j <= 10; ++j)
+      planes.emplace_back(0.3f * i, 0.3f * j, (i > 3 && j % 2 == 0) ? -1.45f : -1.7f);
+  OdometryConfig c;
+  c.map.plane_spacing_m = 0.0;
+  FeatureMap map(c.registration, c.map);
+  map.insert({}, planes, Eigen::Isometry3d::Identity());
+  const Eigen::Isometry3d T = Eigen::Isometry3d::Identity();  // the solution: align stays there
+  for (const double flat_m : {0.2, 0.1}) {
+    SCOPED_TRACE(flat_m);
+    c.registration.plane_max_dist_m = flat_m;
+    ScanToMapRegistration registration(c.registration);
+    const auto [edges, plane_matches] = registration.count_matches({}, planes, map, T);
+    EXPECT_EQ(edges, 0);
+    EXPECT_EQ(plane_matches, register_features({}, planes, map, T, c.registration, 1).plane_matches);
+    if (flat_m == 0.2) EXPECT_GT(plane_matches, static_cast<int>(planes.size()) * 9 / 10);
+    else EXPECT_LT(plane_matches, static_cast<int>(planes.size()) * 3 / 4);
+  }
+}
+
 }  // namespace
 }  // namespace scfloam

@@ -22,6 +22,11 @@ struct LoopRegistrationConfig {
   // plane in the submap and their mean distance is below max_mean_residual_m.
   double min_inlier_fraction = 0.45;
   double max_mean_residual_m = 0.08;
+  // The fraction counts plane matches under this flatness test (F-LOAM's 0.2 m, which the
+  // 0.45 was measured with), not under the solve's stricter registration.plane_max_dist_m:
+  // the solve refuses rough patches to keep their bias out of the pose, but a rough patch
+  // that lies on the submap's surface still says the match is right.
+  double check_plane_max_dist_m = 0.2;
   // An accepted feature match's pose-graph edge takes its information from the match, the
   // Hessian over the residual variance, divided by this: the residuals of neighbouring points
   // are not independent (shared map points, the scan's own distortion), so the Hessian alone

@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "scfloam/config.hpp"
@@ -66,6 +67,11 @@ class ScanToMapRegistration {
   RegistrationResult align(const FeatureCloud& edges_lidar, const FeatureCloud& planes_lidar,
                            const FeatureMap& map, const Eigen::Isometry3d& T_world_lidar_init,
                            int rounds);
+
+  // The correspondences a round would start from at T_world_lidar, without solving: e.g. to
+  // check a solved pose under another match test. {edge matches, plane matches}.
+  std::pair<int, int> count_matches(const FeatureCloud& edges_lidar, const FeatureCloud& planes_lidar,
+                                    const FeatureMap& map, const Eigen::Isometry3d& T_world_lidar);
 
   // Correspondences of the last round (for tests and diagnostics).
   const std::vector<EdgeMatch>& edge_matches() const { return edge_out_; }
