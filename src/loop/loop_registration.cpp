@@ -3,6 +3,7 @@
 #include <Eigen/Eigenvalues>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 
 #include "scfloam/se3.hpp"
 
@@ -128,11 +129,14 @@ LoopMatch register_loop_features(const KeyframeView& current, const LoopSubmap& 
   const Eigen::Isometry3d T_anchor_loop = T_world_anchor.inverse() * T_world_loop;
   ScanToMapRegistration coarse_solver(coarse_registration(config, registration));
   ScanToMapRegistration fine_solver(registration);
-  // Counts the check's matches at the solved pose.
-  RegistrationConfig check_registration = registration;
-  check_registration.plane_max_dist_m = config.check_plane_max_dist_m;
-  const bool separate_check = check_registration.plane_max_dist_m != registration.plane_max_dist_m;
-  ScanToMapRegistration check_solver(check_registration);
+  // Counts the check's matches at the solved pose, when its flatness test differs from the
+  // solve's (otherwise the solve's own counts are the check's).
+  std::optional<ScanToMapRegistration> check_solver;
+  if (config.check_plane_max_dist_m != registration.plane_max_dist_m) {
+    RegistrationConfig check_registration = registration;
+    check_registration.plane_max_dist_m = config.check_plane_max_dist_m;
+    check_solver.emplace(check_registration);
+  }
   const std::vector<Eigen::Isometry3d> guesses =
       loop_initial_guesses(T_world_loop, current.T_world_lidar, sc_yaw_rad);
   // Attempt 0 (fine_first): the fine stage alone from the pose guess; then coarse to fine from
@@ -153,9 +157,9 @@ LoopMatch register_loop_features(const KeyframeView& current, const LoopSubmap& 
     if (config.information_inflation > 0)
       match.information = loop_edge_information(r, T_anchor_loop, config.information_inflation);
     int inliers = r.edge_matches + r.plane_matches;
-    if (separate_check) {
+    if (check_solver) {
       const auto [edges, planes] =
-          check_solver.count_matches(*current.edges, *current.planes, submap.fine(), r.T_world_lidar);
+          check_solver->count_matches(*current.edges, *current.planes, submap.fine(), r.T_world_lidar);
       inliers = edges + planes;
     }
     match.inlier_fraction = static_cast<double>(inliers) / features;
