@@ -62,7 +62,7 @@ struct RegistrationConfig {
   // Reject a plane match whose neighbours spread along one line only (second covariance
   // eigenvalue < ratio * largest): a single ring's trace fits any plane through it (0 = off).
   double plane_min_spread_ratio = 0.0;
-  double huber_delta_m = 0.1;
+  double huber_delta_m = 0.05;      // F-LOAM / SPEC: 0.1 (docs/odometry.md, "Session 15")
   int inner_iterations = 4;          // Ceres iterations per correspondence round
   int outer_iterations = 2;          // correspondence rounds per frame in steady state
   int outer_iterations_initial = 12; // rounds on the first frame, decreasing by one per frame

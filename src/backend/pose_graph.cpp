@@ -69,38 +69,63 @@ double PoseGraph::edge_chi2(std::size_t edge) const {
   return r.squaredNorm();
 }
 
+std::size_t PoseGraph::worst_loop(double min_chi2, std::size_t first_free_node) const {
+  std::size_t worst = edges_.size();
+  double worst_chi2 = min_chi2;
+  for (std::size_t i = 0; i < edges_.size(); ++i) {
+    if (!edges_[i].is_loop || !edges_[i].active || !in_window(edges_[i], first_free_node)) continue;
+    const double chi2 = edge_chi2(i);
+    if (chi2 > worst_chi2) {
+      worst_chi2 = chi2;
+      worst = i;
+    }
+  }
+  return worst;
+}
+
 PoseGraphReport PoseGraph::optimize(const PoseGraphConfig& config, std::size_t first_free_node) {
   Stopwatch watch;
   // Least squares first: a bounded kernel from the drifted start would treat a genuine first
   // loop (metres of discrepancy) as an outlier. Inconsistent loops are pruned, then the
   // Cauchy kernel polishes from the closed configuration, where true loops fit well.
   PoseGraphReport report = solve_once(config, /*robust=*/false, first_free_node);
-  const double polish_chi2 = 0.25 * config.loop_cauchy_scale * config.loop_cauchy_scale;
-  bool needs_polish = false;
-  for (int round = 0; round <= config.max_outlier_rounds; ++round) {
-    // Switch off the worst inconsistent loop only: one false loop can make its true
-    // neighbours look bad until it is gone.
-    std::size_t worst = edges_.size();
-    double worst_chi2 = config.loop_outlier_chi2;
-    needs_polish = false;
-    for (std::size_t i = 0; i < edges_.size(); ++i) {
-      if (!edges_[i].is_loop || !edges_[i].active || !in_window(edges_[i], first_free_node))
-        continue;
-      const double chi2 = edge_chi2(i);
-      needs_polish |= chi2 > polish_chi2;
-      if (chi2 > worst_chi2) {
-        worst_chi2 = chi2;
-        worst = i;
-      }
-    }
-    if (worst == edges_.size() || round == config.max_outlier_rounds) break;
+  // A window cannot judge a loop: its anchored nodes may carry drift that only freeing them
+  // would remove, so a true loop can misfit there and would be switched off for good. When a
+  // loop misfits in the window, the whole graph is solved and judges it instead.
+  if (first_free_node > 0 && worst_loop(config.loop_outlier_chi2, first_free_node) < edges_.size()) {
+    first_free_node = 0;
+    report.escalated = true;
+    report.iterations += solve_once(config, false, 0).iterations;
+  }
+  report.first_free_node = first_free_node;
+  // Switch off the worst inconsistent loop only, then solve again: one false loop can make its
+  // true neighbours look bad until it is gone.
+  for (int round = 0; round < config.max_outlier_rounds; ++round) {
+    const std::size_t worst = worst_loop(config.loop_outlier_chi2, first_free_node);
+    if (worst == edges_.size()) break;
     edges_[worst].active = false;
     report.rejected_edges.push_back(worst);
     report.iterations += solve_once(config, false, first_free_node).iterations;
   }
+  // A false loop can pull a true neighbour further out than itself, so the neighbour goes off
+  // first, in this solve or an earlier one; once the false one is off too, the neighbour fits
+  // again and is given back.
+  bool restored = false;
+  for (std::size_t i = 0; i < edges_.size(); ++i) {
+    if (!edges_[i].is_loop || edges_[i].active || !in_window(edges_[i], first_free_node)) continue;
+    if (edge_chi2(i) >= config.loop_outlier_chi2) continue;
+    edges_[i].active = restored = true;
+    const auto rejected = std::find(report.rejected_edges.begin(), report.rejected_edges.end(), i);
+    if (rejected != report.rejected_edges.end())
+      report.rejected_edges.erase(rejected);
+    else
+      report.restored_edges.push_back(i);
+  }
+  if (restored) report.iterations += solve_once(config, false, first_free_node).iterations;
   // Where every loop fits well within the kernel's scale the Cauchy solution is the
   // least-squares one to within tolerance: skip the extra solve.
-  if (needs_polish) {
+  const double polish_chi2 = 0.25 * config.loop_cauchy_scale * config.loop_cauchy_scale;
+  if (worst_loop(polish_chi2, first_free_node) < edges_.size()) {
     const PoseGraphReport polished = solve_once(config, true, first_free_node);
     report.iterations += polished.iterations;
     report.final_cost = polished.final_cost;

@@ -126,12 +126,16 @@ bool LoopClosure::add(const KeyframePtr& keyframe, const LoopQuery& detected, bo
     graph_.add_edge({k, loop_kf, match.T_loop_current.inverse(), L, true});
   }
   loop_rows_.push_back(*row);
-  earliest_partner_ = std::min(earliest_partner_, loop_kf);
-  earliest_current_ = std::min(earliest_current_, k);
   // A loop the graph already agrees with joins it for the next solve, the poses standing; one
   // that arrives while keyframes wait for this stage waits for the backlog's solve.
   const bool agrees =
       graph_.edge_chi2(graph_.edges().size() - 1) < config_.pose_graph.skip_solve_loop_chi2;
+  // Only a loop that needs a solve widens the next window: one that agrees needs no node
+  // freed, and holding its ends free would let it stretch the window past its cap.
+  if (!agrees) {
+    earliest_partner_ = std::min(earliest_partner_, loop_kf);
+    earliest_current_ = std::min(earliest_current_, k);
+  }
   const auto max_deferred = static_cast<std::size_t>(std::max(config_.pipeline.max_deferred_loops, 0));
   const bool defer = !agrees && backlog && pending_deferred_ < max_deferred;
   solves_skipped_ += agrees;
@@ -174,16 +178,17 @@ std::size_t LoopClosure::first_free_node(bool whole_graph) const {
 }
 
 void LoopClosure::solve(bool whole_graph) {
-  const std::size_t first_free = first_free_node(whole_graph);
   Stopwatch watch;
-  const PoseGraphReport report = graph_.optimize(config_.pose_graph, first_free);
+  const PoseGraphReport report = graph_.optimize(config_.pose_graph, first_free_node(whole_graph));
   optimization_ms_.push_back(watch.elapsed_ms());
+  const std::size_t first_free = report.first_free_node;  // 0 if the solve escalated
   if (on_solve_) {
     const std::size_t fixed = std::min(std::max<std::size_t>(first_free, 1), graph_.size());
-    on_solve_({graph_.size() - fixed, graph_.size(), optimization_ms_.back()});
+    on_solve_({graph_.size() - fixed, graph_.size(), optimization_ms_.back(), report.escalated});
   }
   whole_solve_due_ = first_free > 0;
   window_solves_ += first_free > 0;
+  escalated_solves_ += report.escalated;
   earliest_partner_ = std::numeric_limits<std::size_t>::max();
   earliest_current_ = std::numeric_limits<std::size_t>::max();
   unsolved_loops_ = false;
@@ -197,14 +202,17 @@ void LoopClosure::solve(bool whole_graph) {
 }
 
 void LoopClosure::publish(const PoseGraphReport& report) {
-  // Loops the graph found inconsistent are recorded as rejected in the log.
-  for (std::size_t edge : report.rejected_edges) {
+  // Loops the graph found inconsistent are recorded as rejected in the log, and those it
+  // switched back on as accepted again.
+  auto set_verdict = [&](std::size_t edge, LoopVerdict verdict) {
     std::size_t loop_number = 0;
     for (std::size_t e = 0; e < edge; ++e) loop_number += graph_.edges()[e].is_loop;
     const auto& logged = log_.rows()[loop_rows_.at(loop_number)];
-    log_.set_match(loop_rows_[loop_number], LoopVerdict::kRejectedMatch,
-                   logged.match_inlier_fraction, logged.match_residual_m);
-  }
+    log_.set_match(loop_rows_[loop_number], verdict, logged.match_inlier_fraction,
+                   logged.match_residual_m);
+  };
+  for (std::size_t edge : report.rejected_edges) set_verdict(edge, LoopVerdict::kRejectedMatch);
+  for (std::size_t edge : report.restored_edges) set_verdict(edge, LoopVerdict::kAccepted);
   accepted_ = graph_.loop_edge_count();
   store_.set_optimized(graph_.poses());
 }

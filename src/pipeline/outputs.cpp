@@ -156,7 +156,9 @@ nlohmann::json make_summary(const ScanSource& source, const RunResult& result) {
                         {"rejected", result.loop_rows.size() - accepted},
                         // accepted without a graph solve: consistent with the estimate
                         {"solves_skipped", result.loop_solves_skipped},
-                        {"solves_deferred", result.loop_solves_deferred}};
+                        {"solves_deferred", result.loop_solves_deferred},
+                        {"window_solves", result.window_solves},
+                        {"escalated_solves", result.escalated_solves}};
   }
   // Accuracy against the source's ground truth, when it has one for every processed frame.
   const PoseList gt_lidar = source.ground_truth_lidar();

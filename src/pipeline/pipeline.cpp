@@ -455,6 +455,8 @@ RunResult run_slam(const ScanSource& source, const SlamConfig& base_config,
     result.timing_ms["heap_trim"] = closure.heap_trim_ms();
     result.loop_solves_skipped = closure.solves_skipped();
     result.loop_solves_deferred = closure.solves_deferred();
+    result.window_solves = closure.window_solves();
+    result.escalated_solves = closure.escalated_solves();
     result.loop_rows = closure.log().rows();
     result.graph = std::make_shared<PoseGraph>(closure.graph());
   }

@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <limits>
 #include <random>
 #include <sstream>
 
@@ -49,6 +50,15 @@ PoseList drifted(const PoseList& truth, double yaw_bias_per_step) {
   return out;
 }
 
+// Nodes at the odometry's poses, chained by its relative motions.
+PoseGraph odometry_chain(const PoseList& odom, const PoseGraphConfig& config) {
+  PoseGraph graph;
+  for (const auto& T : odom) graph.add_node(T);
+  for (std::size_t i = 1; i < odom.size(); ++i)
+    graph.add_odometry_edge(i - 1, i, odom[i - 1].inverse() * odom[i], config);
+  return graph;
+}
+
 }  // namespace
 
 TEST(PoseGraph, ClosesASquareLoopWithDrift) {
@@ -58,10 +68,7 @@ TEST(PoseGraph, ClosesASquareLoopWithDrift) {
   ASSERT_GT(max_position_error(truth, odom), 0.4);  // the drift is real
 
   PoseGraphConfig config;
-  PoseGraph graph;
-  for (const auto& T : odom) graph.add_node(T);
-  for (std::size_t i = 1; i < odom.size(); ++i)
-    graph.add_odometry_edge(i - 1, i, odom[i - 1].inverse() * odom[i], config);
+  PoseGraph graph = odometry_chain(odom, config);
   // The loop: the last node is measured to coincide with the first.
   graph.add_loop_edge(odom.size() - 1, 0, truth.back().inverse() * truth[0], config);
   const PoseGraphReport report = graph.optimize(config);
@@ -82,15 +89,14 @@ TEST(PoseGraph, BoundedWindowHoldsTheOlderNodesAndMatchesTheWholeGraph) {
   const Eigen::Isometry3d T_meas = truth[last].inverse() * truth[first];
   PoseGraphConfig config;
   auto make_graph = [&] {
-    PoseGraph graph;
-    for (const auto& T : odom) graph.add_node(T);
-    for (std::size_t i = 1; i < odom.size(); ++i)
-      graph.add_odometry_edge(i - 1, i, odom[i - 1].inverse() * odom[i], config);
+    PoseGraph graph = odometry_chain(odom, config);
     graph.add_loop_edge(last, first, T_meas, config);
     return graph;
   };
   PoseGraph window = make_graph(), whole = make_graph();
-  window.optimize(config, first);
+  const PoseGraphReport report = window.optimize(config, first);
+  EXPECT_FALSE(report.escalated);  // the loop fits within the window: no need to free more
+  EXPECT_EQ(report.first_free_node, first);
   whole.optimize(config);
   for (std::size_t i = 0; i < first; ++i) EXPECT_TRUE(window.pose(i).isApprox(odom[i], 1e-12)) << i;
   auto gap_m = [&](const PoseGraph& g) {
@@ -100,6 +106,71 @@ TEST(PoseGraph, BoundedWindowHoldsTheOlderNodesAndMatchesTheWholeGraph) {
   EXPECT_LT(gap_m(window), 0.5 * open_m);
   for (std::size_t i = first; i <= last; ++i)
     EXPECT_LT((window.pose(i).translation() - whole.pose(i).translation()).norm(), 1e-3) << i;
+}
+
+// A window too short to absorb a loop's discrepancy must not judge the loop: anchored nodes
+// carry drift only the whole graph can remove. The solve escalates to the whole graph, which
+// keeps a true loop and still switches off a false one.
+TEST(PoseGraph, WindowTooShortForALoopEscalatesToTheWholeGraph) {
+  const PoseList truth = square_truth();
+  const PoseList odom = drifted(truth, 3e-4);
+  const std::size_t last = odom.size() - 1, first_free = last - 5;
+  PoseGraphConfig config;
+  auto make_graph = [&](bool with_false_loop) {
+    PoseGraph graph = odometry_chain(odom, config);
+    graph.add_loop_edge(last, 0, truth[last].inverse() * truth[0], config);
+    if (with_false_loop)  // claims node 97 sits on node 60: metres wrong
+      graph.add_loop_edge(last - 3, 60, Eigen::Isometry3d::Identity(), config);
+    return graph;
+  };
+  // Held to its last 5 nodes, the loop cannot fit: the window alone would call it an outlier.
+  {
+    PoseGraph held = make_graph(false);
+    PoseGraphConfig no_judging = config;
+    no_judging.loop_outlier_chi2 = std::numeric_limits<double>::infinity();
+    EXPECT_FALSE(held.optimize(no_judging, first_free).escalated);
+    EXPECT_GT(held.edge_chi2(held.edges().size() - 1), config.loop_outlier_chi2);
+  }
+  PoseGraph graph = make_graph(false);
+  const PoseGraphReport report = graph.optimize(config, first_free);
+  EXPECT_TRUE(report.escalated);
+  EXPECT_EQ(report.first_free_node, 0u);
+  EXPECT_TRUE(report.rejected_edges.empty());
+  EXPECT_EQ(graph.loop_edge_count(), 1u);
+  EXPECT_LT(max_position_error(truth, graph.poses()), 0.3);  // closed as by a whole solve
+
+  PoseGraph polluted = make_graph(true);
+  const PoseGraphReport polluted_report = polluted.optimize(config, first_free);
+  EXPECT_TRUE(polluted_report.escalated);
+  ASSERT_EQ(polluted_report.rejected_edges.size(), 1u);
+  EXPECT_EQ(polluted.edges()[polluted_report.rejected_edges[0]].to, 60u);
+  EXPECT_EQ(polluted.loop_edge_count(), 1u);
+  EXPECT_LT(max_position_error(truth, polluted.poses()), 0.3);
+}
+
+// A loop switched off by an earlier solve (say, while a false loop pulled the graph its way)
+// is given back once it fits the solution without it; a loop that still misfits stays off.
+TEST(PoseGraph, SwitchesBackOnAnEarlierRejectedLoopThatFitsAgain) {
+  const PoseList truth = square_truth();
+  const PoseList odom = drifted(truth, 3e-4);
+  PoseGraphConfig config;
+  PoseGraph graph = odometry_chain(odom, config);
+  const Eigen::Matrix<double, 6, 6> info =
+      sqrt_information_from_sigmas(config.loop_rotation_sigma_rad, config.loop_translation_sigma_m);
+  const std::size_t last = odom.size() - 1;
+  graph.add_edge({last, 0, truth[last].inverse() * truth[0], info, true, true});
+  // Switched off earlier: a true loop (node 99 on node 1) and a false one (node 75 on node 25).
+  graph.add_edge({last - 1, 1, truth[last - 1].inverse() * truth[1], info, true, false});
+  graph.add_edge({75, 25, Eigen::Isometry3d::Identity(), info, true, false});
+  const PoseGraphReport report = graph.optimize(config);
+  EXPECT_TRUE(report.rejected_edges.empty());
+  ASSERT_EQ(report.restored_edges.size(), 1u);
+  EXPECT_EQ(graph.edges()[report.restored_edges[0]].from, last - 1);
+  EXPECT_TRUE(graph.edges()[report.restored_edges[0]].active);
+  EXPECT_FALSE(graph.edges().back().active);
+  EXPECT_EQ(graph.loop_edge_count(), 2u);
+  EXPECT_LT(graph.edge_chi2(report.restored_edges[0]), config.loop_outlier_chi2);
+  EXPECT_LT(max_position_error(truth, graph.poses()), 0.3);
 }
 
 TEST(PoseGraph, RobustKernelLimitsAFalseLoop) {

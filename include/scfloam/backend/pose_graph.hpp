@@ -6,7 +6,8 @@
 //   less;
 // - after a least-squares solve, a loop whose whitened residual is still beyond a chi-square bound is
 //   inconsistent with the odometry and the other loops: it is switched off and the graph is
-//   solved again. A bounded kernel alone cannot do this job: a genuine first loop after a long
+//   solved again; a loop switched off earlier that fits the new solution is switched back
+//   on (a false loop can make its true neighbour misfit first). A bounded kernel alone cannot do this job: a genuine first loop after a long
 //   drive carries metres of discrepancy, which a tight kernel would treat as an outlier and
 //   leave the loop open.
 #pragma once
@@ -29,7 +30,7 @@ struct PoseGraphEdge {
   // transform E = T_from_to^-1 * (T_world_from^-1 * T_world_to).
   Eigen::Matrix<double, 6, 6> sqrt_information = Eigen::Matrix<double, 6, 6>::Identity();
   bool is_loop = false;
-  bool active = true;  // false once the solver found the loop inconsistent
+  bool active = true;  // false while the solver finds the loop inconsistent
 };
 
 struct PoseGraphReport {
@@ -38,6 +39,11 @@ struct PoseGraphReport {
   double solve_ms = 0;
   bool converged = false;
   std::vector<std::size_t> rejected_edges;  // indices into edges() switched off by this solve
+  std::vector<std::size_t> restored_edges;  // loops switched off earlier that fit again
+  // The window actually solved: a windowed solve in which a loop misfits is escalated to the
+  // whole graph (first_free_node 0), which alone judges loops.
+  std::size_t first_free_node = 0;
+  bool escalated = false;
 };
 
 // Square-root information for independent rotation/translation sigmas.
@@ -56,7 +62,8 @@ class PoseGraph {
                      const PoseGraphConfig& config);
 
   // Optimizes all nodes with node 0 held fixed (the map's origin). With first_free_node > 0,
-  // a bounded window: nodes before it stay where they are, and edges among them are left out.
+  // a bounded window: nodes before it stay where they are, and edges among them are left out;
+  // if a loop misfits in the window, the solve is escalated to the whole graph.
   PoseGraphReport optimize(const PoseGraphConfig& config, std::size_t first_free_node = 0);
 
   std::size_t size() const { return nodes_.size(); }
@@ -78,6 +85,8 @@ class PoseGraph {
 
   PoseGraphReport solve_once(const PoseGraphConfig& config, bool robust,
                              std::size_t first_free_node);
+  // The active loop in the window with the largest chi2 above min_chi2, or edges_.size().
+  std::size_t worst_loop(double min_chi2, std::size_t first_free_node) const;
   bool in_window(const PoseGraphEdge& e, std::size_t first_free_node) const {
     return e.from >= first_free_node || e.to >= first_free_node;
   }

@@ -40,6 +40,7 @@ struct LiveCounters {
 struct SolveSample {
   std::size_t free_nodes = 0, nodes = 0;
   double ms = 0;
+  bool escalated = false;  // a window solve that freed the whole graph to judge a misfit loop
 };
 
 struct RunOptions {
@@ -90,6 +91,8 @@ struct RunResult {
   std::vector<LoopCandidate> loop_rows;
   std::size_t loop_solves_skipped = 0;  // accepted loops the graph already agreed with
   std::size_t loop_solves_deferred = 0;  // accepted loops solved later, with a backlog's others
+  std::size_t window_solves = 0;     // graph solves that freed only a window of recent nodes
+  std::size_t escalated_solves = 0;  // window solves escalated to the whole graph by a misfit loop
   std::shared_ptr<const PoseGraph> graph;
   PoseList keyframe_poses;  // final pose of every keyframe
   KeyframeStorageStats keyframe_storage;
