@@ -1,7 +1,7 @@
 // Keyframe pose graph on Ceres: nodes are keyframe poses T_world_kf, edges are measured
 // relative poses T_i_j (odometry between consecutive keyframes, loops from registration).
 //
-// Robustness against wrong loops, in two layers (docs/pose_graph.md):
+// Robustness against wrong loops, in two layers (docs/loop_closure.md, "Pose graph"):
 // - loop edges carry a Cauchy kernel in the final solve, so a mildly inconsistent loop pulls
 //   less;
 // - after a least-squares solve, a loop whose whitened residual is still beyond a chi-square bound is
