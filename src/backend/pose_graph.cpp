@@ -92,20 +92,21 @@ PoseGraphReport PoseGraph::optimize(const PoseGraphConfig& config, std::size_t f
   // A window cannot judge a loop: its anchored nodes may carry drift that only freeing them
   // would remove, so a true loop can misfit there and would be switched off for good. When a
   // loop misfits in the window, the whole graph is solved and judges it instead.
-  if (first_free_node > 0 && worst_loop(config.loop_outlier_chi2, first_free_node) < edges_.size()) {
+  std::size_t worst = worst_loop(config.loop_outlier_chi2, first_free_node);
+  if (first_free_node > 0 && worst < edges_.size()) {
     first_free_node = 0;
     report.escalated = true;
     report.iterations += solve_once(config, false, 0).iterations;
+    worst = worst_loop(config.loop_outlier_chi2, 0);
   }
   report.first_free_node = first_free_node;
   // Switch off the worst inconsistent loop only, then solve again: one false loop can make its
   // true neighbours look bad until it is gone.
-  for (int round = 0; round < config.max_outlier_rounds; ++round) {
-    const std::size_t worst = worst_loop(config.loop_outlier_chi2, first_free_node);
-    if (worst == edges_.size()) break;
+  for (int round = 0; round < config.max_outlier_rounds && worst < edges_.size(); ++round) {
     edges_[worst].active = false;
     report.rejected_edges.push_back(worst);
     report.iterations += solve_once(config, false, first_free_node).iterations;
+    worst = worst_loop(config.loop_outlier_chi2, first_free_node);
   }
   // A false loop can pull a true neighbour further out than itself, so the neighbour goes off
   // first, in this solve or an earlier one; once the false one is off too, the neighbour fits

@@ -4,12 +4,12 @@
 // Robustness against wrong loops, in two layers (docs/loop_closure.md, "Pose graph"):
 // - loop edges carry a Cauchy kernel in the final solve, so a mildly inconsistent loop pulls
 //   less;
-// - after a least-squares solve, a loop whose whitened residual is still beyond a chi-square bound is
-//   inconsistent with the odometry and the other loops: it is switched off and the graph is
-//   solved again; a loop switched off earlier that fits the new solution is switched back
-//   on (a false loop can make its true neighbour misfit first). A bounded kernel alone cannot do this job: a genuine first loop after a long
-//   drive carries metres of discrepancy, which a tight kernel would treat as an outlier and
-//   leave the loop open.
+// - after a least-squares solve, a loop whose whitened residual is still beyond a chi-square
+//   bound is inconsistent with the odometry and the other loops: it is switched off and the
+//   graph is solved again; a loop switched off earlier that fits the new solution is switched
+//   back on (a false loop can make its true neighbour misfit first). A bounded kernel alone
+//   cannot do this job: a genuine first loop after a long drive carries metres of discrepancy,
+//   which a tight kernel would treat as an outlier and leave the loop open.
 #pragma once
 
 #include <Eigen/Core>
