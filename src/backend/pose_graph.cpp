@@ -161,6 +161,13 @@ PoseGraphReport PoseGraph::solve_once(const PoseGraphConfig& config, bool robust
   options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
   options.max_num_iterations = config.max_iterations;
   options.num_threads = 1;  // the other core runs the odometry
+  // Dogleg rather than Levenberg-Marquardt: a pose graph started from odometry is close enough
+  // to quadratic that the Gauss-Newton step is nearly always taken, and LM's damping from its
+  // default radius costs extra factorizations (2000 keyframes, 50 loops: 14 -> 9 iterations).
+  // Dogleg's few long steps stop on Ceres' default 1e-6 cost change ~1 cm short of LM's
+  // answer on a 5000-keyframe window; 1e-8 gives LM's answer for one more iteration.
+  options.trust_region_strategy_type = ceres::DOGLEG;
+  options.function_tolerance = 1e-8;
   ceres::Solver::Summary summary;
   ceres::Solve(options, &problem, &summary);
   report.iterations = static_cast<int>(summary.iterations.size());
