@@ -53,9 +53,14 @@ struct FeatureConfig {
   double plane_leaf_m = 0.8;
 };
 
+// The most map neighbours a registration match may use (VoxelMap keeps them on the stack).
+inline constexpr int kMaxRegistrationKnn = 12;
+
 // Scan-to-map registration (also used by loop registration).
 struct RegistrationConfig {
-  int knn = 5;
+  // Map neighbours of a feature point. F-LOAM's 5 often lie on one ring trace, which any tilted
+  // plane fits and which looks like a line on a wall (docs/parameters.md).
+  int knn = 8;
   double max_neighbor_dist_m = 1.0;  // the k-th neighbour must lie within this
   double edge_line_ratio = 3.0;      // largest covariance eigenvalue > ratio * second
   double plane_max_dist_m = 0.1;     // every neighbour within this of the fitted plane (F-LOAM: 0.2)

@@ -107,6 +107,7 @@ std::vector<Binding> bindings(SlamConfig& c) {
       {lr, "submap_reuse_keyframes", &l.submap_reuse_keyframes},
       {lr, "coarse_radius_m", &l.coarse_radius_m},
       {lr, "coarse_rounds", &l.coarse_rounds},
+      {lr, "knn", &l.knn},
       {lr, "fine_first", &l.fine_first},
       {lr, "rounds", &l.rounds},
       {lr, "min_inlier_fraction", &l.min_inlier_fraction},
@@ -196,7 +197,7 @@ void read_scalar(const YAML::Node& n, T* out, const std::string& full,
 // Values the stages divide by, size buffers with or loop over: a zero or negative one would
 // hang or crash a run far from the config file, so it is refused here, naming the key.
 void check_ranges(const SlamConfig& c, const std::filesystem::path& path) {
-  auto require = [&](bool ok, const char* key, const char* rule) {
+  auto require = [&](bool ok, const char* key, const std::string& rule) {
     if (!ok) throw file_error(path, std::string("`") + key + "` must be " + rule);
   };
   const auto& o = c.odometry;
@@ -209,7 +210,11 @@ void check_ranges(const SlamConfig& c, const std::filesystem::path& path) {
   require(o.features.max_edges_per_sector >= 0, "odometry.features.max_edges_per_sector", ">= 0");
   require(o.features.edge_leaf_m > 0, "odometry.features.edge_leaf_m", "> 0");
   require(o.features.plane_leaf_m > 0, "odometry.features.plane_leaf_m", "> 0");
-  require(o.registration.knn >= 1, "odometry.registration.knn", ">= 1");
+  const std::string knn_range = "in [3, " + std::to_string(kMaxRegistrationKnn) + "]";
+  require(o.registration.knn >= 3 && o.registration.knn <= kMaxRegistrationKnn,
+          "odometry.registration.knn", knn_range);
+  require(c.loop_registration.knn >= 3 && c.loop_registration.knn <= kMaxRegistrationKnn,
+          "loop_registration.knn", knn_range);
   require(o.registration.plane_min_spread_ratio >= 0 && o.registration.plane_min_spread_ratio < 1,
           "odometry.registration.plane_min_spread_ratio", "in [0, 1)");
   require(o.registration.max_neighbor_dist_m > 0, "odometry.registration.max_neighbor_dist_m", "> 0");

@@ -117,7 +117,9 @@ LoopMatch register_loop_features(const KeyframeView& current, const LoopSubmap& 
                                  const Eigen::Isometry3d& T_world_anchor,
                                  const Eigen::Isometry3d& T_world_loop, double sc_yaw_rad,
                                  const LoopRegistrationConfig& config,
-                                 const RegistrationConfig& registration) {
+                                 const RegistrationConfig& odometry_registration) {
+  RegistrationConfig registration = odometry_registration;
+  registration.knn = config.knn;
   LoopMatch best;
   best.reason = "no features";
   if (!current.edges || !current.planes) return best;

@@ -145,6 +145,8 @@ TEST(BadInput, ConfigValuesOutOfRangeNameTheKey) {
       {"odometry:\n  features:\n    edge_leaf_m: 0\n", "odometry.features.edge_leaf_m"},
       {"odometry:\n  features:\n    plane_leaf_m: -1\n", "odometry.features.plane_leaf_m"},
       {"odometry:\n  registration:\n    knn: 0\n", "odometry.registration.knn"},
+      {"odometry:\n  registration:\n    knn: 13\n", "odometry.registration.knn"},
+      {"loop_registration:\n  knn: 2\n", "loop_registration.knn"},
       {"odometry:\n  registration:\n    num_threads: -2\n", "odometry.registration.num_threads"},
       {"odometry:\n  map:\n    max_points_per_cell: 0\n", "odometry.map.max_points_per_cell"},
       {"odometry:\n  registration:\n    max_neighbor_dist_m: .nan\n",

@@ -41,7 +41,9 @@ TEST(ScanToMap, RecoversAKnownMotionOfKitti05Frame0) {
   EXPECT_LT(r.T_world_lidar.translation().norm(), 0.01);
   EXPECT_LT(rotation_angle_rad(r.T_world_lidar.linear()) * 180 / M_PI, 0.02);
   EXPECT_GT(r.plane_matches, 1000);
-  EXPECT_GT(r.edge_matches, 300);
+  // 8 neighbours (the default) must lie on one line within 1 m: 205 edges match here, where
+  // F-LOAM's 5 matched over 300: the more neighbours, the stricter the line test.
+  EXPECT_GT(r.edge_matches, 150);
   EXPECT_FALSE(r.degenerate);
 }
 
@@ -95,6 +97,7 @@ TEST(ScanToMap, PlaneSpreadRatioRejectsARingTraceButKeepsTheGround) {
   planes.insert(planes.end(), traces.begin(), traces.end());
   OdometryConfig c;
   c.map.plane_spacing_m = 0.0;  // keep every point: the neighbourhoods are the ones built here
+  c.registration.knn = 5;       // the counts below are for five neighbours
   FeatureMap map(c.registration, c.map);
   map.insert({}, planes, Eigen::Isometry3d::Identity());
   auto plane_matches = [&](double ratio) {
@@ -118,6 +121,7 @@ TEST(ScanToMap, CountMatchesAtTheSolutionAreAlignsAndFollowTheFlatnessTest) {
       planes.emplace_back(0.3f * i, 0.3f * j, (i > 3 && j % 2 == 0) ? -1.45f : -1.7f);
   OdometryConfig c;
   c.map.plane_spacing_m = 0.0;
+  c.registration.knn = 5;  // the strip's neighbourhoods are built for five neighbours
   FeatureMap map(c.registration, c.map);
   map.insert({}, planes, Eigen::Isometry3d::Identity());
   const Eigen::Isometry3d T = Eigen::Isometry3d::Identity();  // the solution: align stays there

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "scfloam/config.hpp"
 #include "scfloam/registration/voxel_hash.hpp"
 #include "scfloam/types.hpp"
 
@@ -16,7 +17,7 @@ namespace scfloam {
 
 class VoxelMap {
  public:
-  static constexpr int kMaxK = 8;
+  static constexpr int kMaxK = kMaxRegistrationKnn;
 
   struct Neighbors {
     std::array<Eigen::Vector3f, kMaxK> points;
