@@ -108,9 +108,10 @@ TEST(SimOdometry, DistortedScansWithDeskewAndRingField) {
 // A VLP-16's 2 deg rings leave the map's ground and walls as separate traces: five map
 // neighbours of a plane point often lie on one trace, which any tilted plane fits, and the
 // odometry then pitches a little every frame (docs/odometry.md, "Session 17"). The shipped
-// preset (12 neighbours) must hold the attitude on a drive with turns. Measured on this run
-// (tilt drift, end-point error): 12 neighbours 0.22 deg, 0.06 %; 8: 0.29 deg, 0.05 %;
-// F-LOAM's 5: 1.18 deg, 0.38 %.
+// preset (12 neighbours, 0.4 / 0.2 m map spacing) must hold the attitude on a drive with
+// turns. Measured on this run (tilt drift, end-point error): the preset 0.12 deg, 0.02 %; with
+// the preset's earlier 0.2 / 0.1 m spacing, 12 neighbours 0.22 deg, 0.06 %; 8: 0.29 deg,
+// 0.05 %; F-LOAM's 5: 1.18 deg, 0.38 %.
 TEST(SimOdometry, Vlp16PresetHoldsTheAttitudeThroughTurns) {
   sim::SimConfig cfg;
   cfg.sensor = "vlp16";
