@@ -27,6 +27,9 @@ T load_as(const unsigned char* p, bool swap) {
   return v;
 }
 
+// Finite and within float's range (a point's coordinates are stored as float).
+bool fits_float(double v) { return std::abs(v) <= std::numeric_limits<float>::max(); }
+
 double read_value(const unsigned char* p, FieldType type, bool swap) {
   switch (type) {
     case FieldType::kInt8: return load_as<std::int8_t>(p, false);
@@ -184,13 +187,14 @@ void append_points(const unsigned char* data, std::size_t count, std::size_t str
     const double x = read_value(p + fx.offset, fx.type, swap);
     const double y = read_value(p + fy.offset, fy.type, swap);
     const double z = read_value(p + fz.offset, fz.type, swap);
-    if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) continue;
+    // A float64 field can hold finite values beyond float's range, which would become inf here.
+    if (!fits_float(x) || !fits_float(y) || !fits_float(z)) continue;
     q.x = static_cast<float>(x);
     q.y = static_cast<float>(y);
     q.z = static_cast<float>(z);
     if (fi) {
       const double v = read_value(p + fi->offset, fi->type, swap);
-      q.intensity = std::isfinite(v) ? static_cast<float>(v) : 0.f;
+      q.intensity = fits_float(v) ? static_cast<float>(v) : 0.f;
     }
     if (fr) q.ring = static_cast<std::int16_t>(std::clamp(read_value(p + fr->offset, fr->type, swap), -1.0, 32767.0));
     if (time_rule.valid) {

@@ -96,6 +96,28 @@ TEST(Pcd, RoundTripOfEveryEncodingWithAndWithoutRingAndTime) {
   }
 }
 
+// A float64 coordinate can be finite and still beyond float's range (the fuzzer found one):
+// the point is dropped like a NaN, not stored as inf.
+TEST(Pcd, Float64CoordinateBeyondFloatRangeIsDropped) {
+  const fs::path path = test::scratch_dir("pcd_huge") / "huge.pcd";
+  std::string s =
+      "VERSION 0.7\nFIELDS x y z intensity\nSIZE 8 4 4 8\nTYPE F F F F\nWIDTH 3\nHEIGHT 1\n"
+      "POINTS 3\nDATA binary\n";
+  for (int i = 0; i < 3; ++i) {
+    append<double>(s, i == 1 ? 1e300 : 1.0 + i);
+    append<float>(s, 2.f);
+    append<float>(s, 3.f);
+    append<double>(s, i == 2 ? -1e300 : 7.0);  // intensity out of range: 0
+  }
+  write_bytes(path, s);
+  const PointCloudFile f = read_pcd(path);
+  ASSERT_EQ(f.scan.points.size(), 2u);
+  EXPECT_FLOAT_EQ(f.scan.points[0].x, 1.f);
+  EXPECT_FLOAT_EQ(f.scan.points[1].x, 3.f);
+  EXPECT_FLOAT_EQ(f.scan.points[0].intensity, 7.f);
+  EXPECT_FLOAT_EQ(f.scan.points[1].intensity, 0.f);
+}
+
 TEST(Pcd, UnusualLayoutFieldOrderPaddingFloat64Uint8CountAndNaN) {
   const fs::path path = test::scratch_dir("pcd_layout") / "odd.pcd";
   // intensity (uint8) first, a 3-byte padding field `_`, z before x, x/y float64, a normal of
