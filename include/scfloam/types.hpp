@@ -2,7 +2,9 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <cmath>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 namespace scfloam {
@@ -15,6 +17,10 @@ struct LidarPoint {
   float time_s = 0;
   std::int16_t ring = -1;
 };
+
+// Whether a value read as double can be stored in a LidarPoint's float: false for NaN,
+// infinities and finite doubles beyond float's range (which would become inf).
+inline bool fits_float(double v) { return std::abs(v) <= std::numeric_limits<float>::max(); }
 
 struct Scan {
   double timestamp_s = 0;

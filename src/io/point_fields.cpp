@@ -27,9 +27,6 @@ T load_as(const unsigned char* p, bool swap) {
   return v;
 }
 
-// Finite and within float's range (a point's coordinates are stored as float).
-bool fits_float(double v) { return std::abs(v) <= std::numeric_limits<float>::max(); }
-
 double read_value(const unsigned char* p, FieldType type, bool swap) {
   switch (type) {
     case FieldType::kInt8: return load_as<std::int8_t>(p, false);

@@ -116,9 +116,6 @@ TimeRule choose_time_rule(const PointCloud2View& cloud, const PointField& ft, bo
   return {};
 }
 
-// False for NaN, infinities and doubles out of float range.
-bool fits_float(double v) { return std::abs(v) <= std::numeric_limits<float>::max(); }
-
 }  // namespace
 
 std::size_t point_field_size(std::uint8_t datatype) {
