@@ -65,8 +65,8 @@ scfloam::cli::RegisterCommand reg("simulate", [](CLI::App& app) {
       ->check(CLI::IsMember(scfloam::sim::degenerate_scenario_names()));
   sub->add_option("--kitti-poses,--replay", args->replay, "Replay this KITTI poses file (camera-0) through a city built around it")
       ->check(CLI::ExistingFile);
-  sub->add_option("--sensor", args->config.sensor, "hdl64 | vlp16 | hdl32 | os1-128")
-      ->check(CLI::IsMember({"hdl64", "vlp16", "hdl32", "os1-128"}))->capture_default_str();
+  sub->add_option("--sensor", args->config.sensor, "hdl64 | vlp16 | hdl32 | os1-64 | os1-128")
+      ->check(CLI::IsMember({"hdl64", "vlp16", "hdl32", "os1-64", "os1-128"}))->capture_default_str();
   sub->add_flag("--motion-distortion", args->config.motion_distortion, "Cast each column from the pose at its firing time");
   sub->add_option("--range-noise", args->config.range_noise_m, "Range noise sigma in metres (default: the sensor's)")
       ->check(CLI::Range(0.0, 1.0));

@@ -16,7 +16,7 @@ std::vector<double> linear_beams(double top_deg, double bottom_deg, int count) {
 }
 }  // namespace
 
-std::vector<std::string> sensor_preset_names() { return {"hdl64", "vlp16", "hdl32", "os1-128"}; }
+std::vector<std::string> sensor_preset_names() { return {"hdl64", "vlp16", "hdl32", "os1-64", "os1-128"}; }
 
 SensorModel sensor_preset(const std::string& name) {
   SensorModel s;
@@ -38,6 +38,12 @@ SensorModel sensor_preset(const std::string& name) {
     s.elevations_deg = linear_beams(10.67, -30.67, 32);
     s.columns = 2170;  // ~0.166 deg
     s.max_range_m = 100;
+  } else if (name == "os1-64") {
+    // Gen-1 OS1-64: 64 beams over 33.2 deg (0.53 deg apart), as in config/os1-64.yaml's rings.
+    s.elevations_deg = linear_beams(16.6, -16.6, 64);
+    s.columns = 1024;  // 1024 x 10 mode
+    s.max_range_m = 120;
+    s.range_noise_m = 0.03;
   } else if (name == "os1-128") {
     s.elevations_deg = linear_beams(22.5, -22.5, 128);
     s.columns = 1024;  // 1024 x 10 mode

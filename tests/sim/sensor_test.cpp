@@ -59,6 +59,10 @@ TEST(SensorPresets, OtherLayouts) {
   ASSERT_EQ(hdl32.beams(), 32);
   EXPECT_NEAR(hdl32.elevations_deg.front(), 10.67, 1e-9);
   EXPECT_NEAR(hdl32.elevations_deg.back(), -30.67, 1e-9);
+  const SensorModel os64 = sensor_preset("os1-64");
+  ASSERT_EQ(os64.beams(), 64);
+  EXPECT_NEAR(os64.elevations_deg.front(), 16.6, 1e-9);
+  EXPECT_NEAR(os64.elevations_deg.back(), -16.6, 1e-9);
   const SensorModel os = sensor_preset("os1-128");
   ASSERT_EQ(os.beams(), 128);
   EXPECT_NEAR(os.elevations_deg.front(), 22.5, 1e-9);

@@ -33,7 +33,7 @@ struct SensorModel {
   int beams() const { return static_cast<int>(elevations_deg.size()); }
 };
 
-// "hdl64" (Velodyne HDL-64E, KITTI), "vlp16", "hdl32", "os1-128". Throws scfloam::Error
+// "hdl64" (Velodyne HDL-64E, KITTI), "vlp16", "hdl32", "os1-64", "os1-128". Throws scfloam::Error
 // listing the known names for anything else.
 SensorModel sensor_preset(const std::string& name);
 std::vector<std::string> sensor_preset_names();
