@@ -68,6 +68,10 @@ scfloam::cli::RegisterCommand reg("simulate", [](CLI::App& app) {
   sub->add_option("--sensor", args->config.sensor, "hdl64 | vlp16 | hdl32 | os1-64 | os1-128")
       ->check(CLI::IsMember({"hdl64", "vlp16", "hdl32", "os1-64", "os1-128"}))->capture_default_str();
   sub->add_flag("--motion-distortion", args->config.motion_distortion, "Cast each column from the pose at its firing time");
+  sub->add_option("--scan-format", args->config.scan_format,
+                  "velodyne/ as KITTI .bin (x y z reflectance) or binary .pcd with ring and per-point time "
+                  "(for deskew of --motion-distortion scans)")
+      ->check(CLI::IsMember({"bin", "pcd"}))->capture_default_str();
   sub->add_option("--range-noise", args->config.range_noise_m, "Range noise sigma in metres (default: the sensor's)")
       ->check(CLI::Range(0.0, 1.0));
   sub->add_option("--dropout", args->config.dropout_prob, "Random dropout probability (default: the sensor's)")

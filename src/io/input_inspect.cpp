@@ -6,6 +6,7 @@
 #include "scfloam/io/bag_source.hpp"
 #include "scfloam/io/folder_source.hpp"
 #include "scfloam/io/kitti.hpp"
+#include "scfloam/io/point_cloud_file.hpp"
 
 namespace scfloam {
 namespace fs = std::filesystem;
@@ -16,8 +17,16 @@ InputInfo inspect_kitti(const fs::path& dir) {
   InputInfo info;
   info.kind = "KITTI sequence";
   info.scans = seq.size();
-  info.point_fields = {"x:float32", "y:float32", "z:float32", "reflectance:float32"};
-  info.points_in_first_scan = seq.load(0).points.size();
+  const Scan first = seq.load(0);
+  const bool pcd = seq.scan_path(0).extension() == ".pcd";
+  if (pcd) {
+    info.kind = "KITTI sequence (PCD scans)";
+    for (const CloudField& f : read_pcd(seq.scan_path(0)).fields)
+      info.point_fields.push_back(f.name + ":" + field_type_name(f.type));
+  } else {
+    info.point_fields = {"x:float32", "y:float32", "z:float32", "reflectance:float32"};
+  }
+  info.points_in_first_scan = first.points.size();
   if (!seq.times().empty()) {
     info.start_time_s = seq.times().front();
     info.end_time_s = seq.times().back();
@@ -26,7 +35,13 @@ InputInfo inspect_kitti(const fs::path& dir) {
                                                  : "no poses.txt: no accuracy report");
   info.notes.push_back(seq.calib().has_Tr ? "calib.txt has Tr: poses_kitti.txt in camera-0 convention by default"
                                           : "no Tr in calib.txt: poses in the lidar frame (--frame camera refused)");
-  info.notes.push_back("no ring or time fields: rings from elevation, no deskew");
+  if (!first.has_ring && !first.has_time)
+    info.notes.push_back("no ring or time fields: rings from elevation, no deskew");
+  else if (!first.has_time)
+    info.notes.push_back("ring field, no time field: no deskew");
+  else
+    info.notes.push_back(std::string(first.has_ring ? "ring and time fields" : "time field, no ring field") +
+                         ": deskewed when the config says so (preprocess.deskew)");
   return info;
 }
 

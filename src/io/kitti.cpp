@@ -9,6 +9,7 @@
 
 #include "scfloam/atomic_file.hpp"
 #include "scfloam/error.hpp"
+#include "scfloam/io/point_cloud_file.hpp"
 #include "scfloam/io/trajectory.hpp"
 
 namespace scfloam {
@@ -147,8 +148,8 @@ void check_no_gaps(const std::vector<fs::path>& sorted_scans) {
     const long long number = std::stoll(stem);
     if (previous >= 0 && number != previous + 1) {
       char missing[32];
-      std::snprintf(missing, sizeof missing, "%0*lld.bin", static_cast<int>(stem.size()),
-                    previous + 1);
+      std::snprintf(missing, sizeof missing, "%0*lld%s", static_cast<int>(stem.size()),
+                    previous + 1, path.extension().string().c_str());
       throw file_error(path.parent_path() / missing,
                        "missing: the scans jump from " + std::to_string(previous) + " to " +
                            std::to_string(number) +
@@ -168,10 +169,19 @@ KittiSequence KittiSequence::open(const fs::path& dir) {
   const fs::path velodyne = dir / "velodyne";
   if (!fs::is_directory(velodyne))
     throw file_error(dir, "no velodyne/ folder: not a KITTI odometry sequence directory");
+  // KITTI's .bin scans, or PCD scans (which may carry ring and time fields: `scfloam
+  // simulate --scan-format pcd` writes motion-distorted sequences so), never both.
+  std::size_t pcd_count = 0;
   for (const auto& entry : fs::directory_iterator(velodyne)) {
-    if (entry.path().extension() == ".bin") seq.scan_paths_.push_back(entry.path());
+    const fs::path& path = entry.path();
+    if (path.extension() == ".bin" || path.extension() == ".pcd") seq.scan_paths_.push_back(path);
+    if (path.extension() == ".pcd") ++pcd_count;
   }
-  if (seq.scan_paths_.empty()) throw file_error(velodyne, "no .bin scans in the folder");
+  if (seq.scan_paths_.empty()) throw file_error(velodyne, "no .bin or .pcd scans in the folder");
+  if (pcd_count != 0 && pcd_count != seq.scan_paths_.size())
+    throw file_error(velodyne, "holds both .bin and .pcd scans (" + std::to_string(pcd_count) +
+                                   " .pcd of " + std::to_string(seq.scan_paths_.size()) +
+                                   "): keep one kind");
   std::sort(seq.scan_paths_.begin(), seq.scan_paths_.end());
   check_no_gaps(seq.scan_paths_);
 
@@ -203,8 +213,14 @@ KittiSequence KittiSequence::open(const fs::path& dir) {
 
 Scan KittiSequence::load(std::size_t index) const {
   Scan scan;
+  const fs::path& path = scan_paths_.at(index);
+  if (path.extension() == ".pcd") {
+    Scan file_scan = read_pcd(path).scan;  // its ring and time fields, when it has them
+    file_scan.timestamp_s = times_.at(index);
+    return file_scan;
+  }
   scan.timestamp_s = times_.at(index);
-  scan.points = read_kitti_bin(scan_paths_.at(index));
+  scan.points = read_kitti_bin(path);
   return scan;
 }
 

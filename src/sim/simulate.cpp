@@ -7,6 +7,7 @@
 #include "scfloam/atomic_file.hpp"
 #include "scfloam/error.hpp"
 #include "scfloam/io/kitti.hpp"
+#include "scfloam/io/point_cloud_file.hpp"
 #include "scfloam/io/trajectory.hpp"
 #include "scfloam/progress.hpp"
 #include "scfloam/sim/degenerate.hpp"
@@ -57,6 +58,9 @@ PoseList relative_lidar_poses(const Scenario& sc) {
 }
 
 void simulate_sequence(const SimConfig& config, const fs::path& out_dir, bool progress) {
+  if (config.scan_format != "bin" && config.scan_format != "pcd")
+    throw Error("simulate: scan format \"" + config.scan_format + "\" is not bin or pcd");
+  const bool pcd = config.scan_format == "pcd";
   Stopwatch clock;
   const SensorModel sensor = sensor_for(config);
   const Scenario sc = build_scenario(config);
@@ -66,6 +70,15 @@ void simulate_sequence(const SimConfig& config, const fs::path& out_dir, bool pr
   std::error_code ec;
   fs::create_directories(out_dir / "velodyne", ec);
   if (ec) throw file_error(out_dir, "cannot create the output directory: " + ec.message());
+  // Writing over an earlier sequence (--force): its scans go first, or a longer run or the
+  // other scan format would leave scans that times.txt and poses.txt do not count.
+  for (const auto& entry : fs::directory_iterator(out_dir / "velodyne")) {
+    const fs::path& path = entry.path();
+    if (entry.is_regular_file() && (path.extension() == ".bin" || path.extension() == ".pcd")) {
+      fs::remove(path, ec);
+      if (ec) throw file_error(path, "cannot remove the earlier scan: " + ec.message());
+    }
+  }
 
   ProgressBar bar("simulate", sc.frames, progress);
   std::size_t total_points = 0, movers_within_50m = 0;
@@ -82,8 +95,9 @@ void simulate_sequence(const SimConfig& config, const fs::path& out_dir, bool pr
     movers_within_50m += traffic.count_near(t, poses.T_world_lidar.translation().head<2>(), 50);
     total_points += scan.points.size();
     char name[32];
-    std::snprintf(name, sizeof name, "%06zu.bin", k);
-    write_kitti_bin(out_dir / "velodyne" / name, scan.points);
+    std::snprintf(name, sizeof name, "%06zu.%s", k, pcd ? "pcd" : "bin");
+    if (pcd) write_pcd(out_dir / "velodyne" / name, scan.points, PcdEncoding::kBinary, /*with_ring_time=*/true);
+    else write_kitti_bin(out_dir / "velodyne" / name, scan.points);
     char note[64];
     std::snprintf(note, sizeof note, "%.1f ms/frame", clock.elapsed_ms() / (k + 1));
     bar.update(k + 1, note);
@@ -124,6 +138,7 @@ void simulate_sequence(const SimConfig& config, const fs::path& out_dir, bool pr
     out << "beam_azimuth_error_deg: " << sensor.beam_azimuth_error_deg << "\n";
     out << "beam_range_bias_m: " << sensor.beam_range_bias_m << "\n";
     out << "motion_distortion: " << (config.motion_distortion ? "true" : "false") << "\n";
+    out << "scan_format: " << config.scan_format << "\n";
     out << "world:\n  primitives: " << sc.world.primitives.size() << "\n  buildings: " << sc.stats.buildings
         << "\n  trees: " << sc.stats.trees << "\n  poles: " << sc.stats.poles << "\n  cars: " << sc.stats.cars
         << "\n  signs: " << sc.stats.signs << "\n";

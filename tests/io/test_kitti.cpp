@@ -4,6 +4,7 @@
 
 #include "scfloam/error.hpp"
 #include "scfloam/io/kitti.hpp"
+#include "scfloam/io/point_cloud_file.hpp"
 #include "scfloam/io/trajectory.hpp"
 #include "scfloam/se3.hpp"
 #include "test_paths.hpp"
@@ -60,6 +61,8 @@ TEST(KittiReader, ClearErrors) {
   fs::create_directories(dir / "seq" / "velodyne");
   write_kitti_bin(dir / "seq" / "velodyne" / "000000.bin", std::vector<LidarPoint>(2));
   expect_error(dir / "seq" / "calib.txt", "missing", [&] { KittiSequence::open(dir / "seq"); });
+  write_pcd(dir / "seq" / "velodyne" / "000001.pcd", std::vector<LidarPoint>(2), PcdEncoding::kBinary);
+  expect_error(dir / "seq" / "velodyne", "both .bin and .pcd", [&] { KittiSequence::open(dir / "seq"); });
   {
     std::ofstream odd(dir / "odd.bin", std::ios::binary);
     odd << "0123456789";

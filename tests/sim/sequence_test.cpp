@@ -8,6 +8,7 @@
 #include <fstream>
 #include <iterator>
 
+#include "scfloam/error.hpp"
 #include "scfloam/io/kitti.hpp"
 #include "scfloam/sim/scan.hpp"
 #include "scfloam/sim/simulate.hpp"
@@ -178,6 +179,48 @@ TEST(SimulateDeterminism, SameSeedSameBytes) {
   const fs::path c = test::scratch_dir("sim_det_c");
   simulate_sequence(cfg, c, false);
   EXPECT_NE(slurp(a / "velodyne/000000.bin"), slurp(c / "velodyne/000000.bin"));
+}
+
+// `--scan-format pcd`: the same scans as .bin, plus ring and per-point time, read back through
+// the KITTI reader; writing it over an earlier .bin sequence leaves no .bin behind.
+TEST(SimulatePcdScans, RingAndTimeSurviveTheKittiReader) {
+  SimConfig cfg;
+  cfg.sensor = "vlp16";
+  cfg.seed = 4;
+  cfg.frames = 3;
+  cfg.motion_distortion = true;
+  const fs::path dir = test::scratch_dir("sim_pcd");
+  simulate_sequence(cfg, dir, false);
+  const Scan bin_scan = KittiSequence::open(dir).load(1);
+  cfg.frames = 2;
+  cfg.scan_format = "pcd";
+  simulate_sequence(cfg, dir, false);
+  EXPECT_FALSE(fs::exists(dir / "velodyne/000000.bin"));
+  EXPECT_FALSE(fs::exists(dir / "velodyne/000002.bin"));
+  const KittiSequence seq = KittiSequence::open(dir);
+  ASSERT_EQ(seq.size(), 2u);
+  const Scan scan = seq.load(1);
+  EXPECT_NEAR(scan.timestamp_s, 0.1, 1e-9);
+  ASSERT_TRUE(scan.has_ring);
+  ASSERT_TRUE(scan.has_time);
+  ASSERT_EQ(scan.points.size(), bin_scan.points.size());
+  float t_lo = 1, t_hi = -1;
+  int ring_hi = 0;
+  for (std::size_t i = 0; i < scan.points.size(); ++i) {
+    const LidarPoint &p = scan.points[i], &q = bin_scan.points[i];
+    ASSERT_EQ(p.x, q.x);
+    ASSERT_EQ(p.z, q.z);
+    t_lo = std::min(t_lo, p.time_s);
+    t_hi = std::max(t_hi, p.time_s);
+    ring_hi = std::max<int>(ring_hi, p.ring);
+  }
+  // A sweep of 0.1 s around the frame's stamp; 16 beams.
+  EXPECT_LT(t_lo, -0.045f);
+  EXPECT_GT(t_hi, 0.045f);
+  EXPECT_LE(t_hi - t_lo, 0.1f);
+  EXPECT_EQ(ring_hi, 15);
+  cfg.scan_format = "ply";
+  EXPECT_THROW(simulate_sequence(cfg, dir, false), Error);
 }
 
 TEST(SimulateMotionDistortion, ColumnsFollowTheMovingSensor) {

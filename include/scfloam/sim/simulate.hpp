@@ -27,6 +27,9 @@ struct SimConfig {
   std::filesystem::path replay_poses;  // KITTI camera-0 poses file for route "kitti"
   std::string sensor = "hdl64";   // see sensor_preset_names()
   bool motion_distortion = false;  // KITTI's own scans are already compensated
+  // velodyne/ as KITTI's "bin" (x y z reflectance), or "pcd" (binary PCD with ring and
+  // per-point time, seconds from the frame's stamp): what deskew needs on distorted scans.
+  std::string scan_format = "bin";
   // Overrides of the preset's noise (negative = keep the preset's value).
   double range_noise_m = -1;
   double dropout_prob = -1;
