@@ -29,6 +29,11 @@ struct Odometry::Impl {
   ScanToMapRegistration registration;
 
   std::vector<LidarPoint> deskewed;
+  // Frames 0 and 1 come before there is a velocity to deskew with: their raw points and poses
+  // are kept so that frame 2 can put them into the map again, deskewed.
+  std::vector<LidarPoint> early_points[2];
+  Eigen::Isometry3d early_poses[2];
+  bool early_has_ring = false;
   FeatureCloud raw_edges, raw_planes;
   FeatureCloud last_edges, last_planes;  // the previous frame's features, for the coarse pass
   std::size_t frames = 0;
@@ -120,12 +125,19 @@ OdometryResult Odometry::process(const Scan& scan) {
   Stopwatch watch;
 
   const std::vector<LidarPoint>* points = &scan.points;
-  if (c.preprocess.deskew && scan.has_time && s.frames >= 2 && s.delta_dt_s > 0) {
+  const bool deskew = c.preprocess.deskew && scan.has_time;
+  if (deskew && s.frames >= 2 && s.delta_dt_s > 0) {
     // Constant velocity from the last two poses, in the sensor's body frame.
+    const Eigen::Vector3d omega = so3_log(s.T_delta.linear()) / s.delta_dt_s;
+    const Eigen::Vector3d velocity = s.T_delta.translation() / s.delta_dt_s;
+    if (s.frames == 2) redeskew_first_frames(omega, velocity);
     s.deskewed = scan.points;
-    deskew_constant_velocity(s.deskewed, so3_log(s.T_delta.linear()) / s.delta_dt_s,
-                             s.T_delta.translation() / s.delta_dt_s);
+    deskew_constant_velocity(s.deskewed, omega, velocity);
     points = &s.deskewed;
+  }
+  if (deskew && s.frames < 2) {
+    s.early_points[s.frames] = scan.points;
+    s.early_has_ring = scan.has_ring && c.rings.use_ring_field;
   }
   s.extractor.extract(*points, scan.has_ring && c.rings.use_ring_field, s.raw_edges, s.raw_planes);
   s.edge_filter.filter(s.raw_edges, c.features.edge_leaf_m, result.edges);
@@ -222,11 +234,40 @@ OdometryResult Odometry::process(const Scan& scan) {
     s.map.remove_far(position, c.map.radius_m);
     s.last_cleanup_position = position;
   }
+  if (s.frames < 2) s.early_poses[s.frames] = result.T_world_lidar;
   s.T_last = result.T_world_lidar;
   s.last_stamp_s = scan.timestamp_s;
   ++s.frames;
   result.registration_ms = watch.elapsed_ms();
   return result;
+}
+
+// The map holds frames 0 and 1 as they were scanned, smeared by the motion during each sweep;
+// being the first points in their cells, they would stay while later, deskewed frames are
+// turned away from full cells, and the next frames match against the smear (a 1-2 cm
+// transient on a distorted drive, docs/odometry.md). Once frame 1 gives a velocity, the map
+// is rebuilt from both frames deskewed with it (the car is assumed to have moved the same way
+// during the two sweeps), at their estimated poses.
+void Odometry::redeskew_first_frames(const Eigen::Vector3d& omega_rad_s,
+                                     const Eigen::Vector3d& velocity_m_s) {
+  Impl& s = *impl_;
+  if (s.early_points[0].empty() || s.early_points[1].empty()) return;
+  s.map.clear();
+  FeatureCloud edges, planes;
+  for (int k = 0; k < 2; ++k) {
+    std::vector<LidarPoint>& points = s.early_points[k];
+    deskew_constant_velocity(points, omega_rad_s, velocity_m_s);
+    s.extractor.extract(points, s.early_has_ring, s.raw_edges, s.raw_planes);
+    if (k == 0) {
+      // As on the first pass: frame 0 goes in at full density (see process()).
+      s.map.insert(s.raw_edges, s.raw_planes, s.early_poses[0]);
+    } else {
+      s.edge_filter.filter(s.raw_edges, s.config.features.edge_leaf_m, edges);
+      s.plane_filter.filter(s.raw_planes, s.config.features.plane_leaf_m, planes);
+      s.map.insert(edges, planes, s.early_poses[1]);
+    }
+    std::vector<LidarPoint>().swap(points);  // not needed again
+  }
 }
 
 void Odometry::reset_map(

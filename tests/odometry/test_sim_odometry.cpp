@@ -100,9 +100,10 @@ TEST(SimOdometry, DistortedScansWithDeskewAndRingField) {
   odo.preprocess.deskew = true;
   const Drift d = run_sim(cfg, odo, /*use_rings=*/true);
   EXPECT_LT(d.end_error_m / d.path_m, 0.01);
-  // Frames 0-1 cannot be deskewed (no velocity yet) and stay in the map: frames 3-5 show a
-  // ~1 cm transient (docs/odometry.md); later frames are at 2-3 mm.
-  EXPECT_LT(d.max_frame_error_m, 0.03);
+  // Frames 0-1 come before any velocity; frame 2 puts them into the map again, deskewed.
+  // Measured: every later frame within 4 mm (end point 1.0 cm); when they stayed in the map
+  // as scanned, the next frames erred by up to 2.0 cm (end point 2.3 cm, docs/odometry.md).
+  EXPECT_LT(d.max_frame_error_m, 0.01);
 }
 
 // A VLP-16's 2 deg rings leave the map's ground and walls as separate traces: five map

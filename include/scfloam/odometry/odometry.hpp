@@ -50,6 +50,8 @@ class Odometry {
                  const Eigen::Isometry3d& T_world_lidar_now);
 
  private:
+  void redeskew_first_frames(const Eigen::Vector3d& omega_rad_s, const Eigen::Vector3d& velocity_m_s);
+
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
