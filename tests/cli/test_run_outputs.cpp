@@ -130,11 +130,17 @@ TEST_F(RunOutputs, MapPlyKeyframesFrameAndForce) {
 }
 
 TEST_F(RunOutputs, SensorPresetsLoadAndLivoxSaysWhyNot) {
-  for (const char* sensor : {"hdl64", "hdl32", "vlp16", "os1-64", "os1-128"}) {
+  for (const char* sensor : {"kitti", "hdl64", "hdl32", "vlp16", "os1-64", "os1-128"}) {
     const Outcome r = run_cli("run " + (root_ / "pcd").string() + " -o " + (root_ / "preset" / sensor).string() +
                               " --mode odometry --quiet -n 2 --sensor " + sensor);
     EXPECT_EQ(r.exit_code, 0) << sensor << ": " << r.output;
+    EXPECT_EQ(r.output.find("no --sensor or --config"), std::string::npos) << sensor << ": " << r.output;
   }
+  // Without a preset a folder of scans runs on KITTI's defaults, and the run says so.
+  Outcome plain = run_cli("run " + (root_ / "pcd").string() + " -o " + (root_ / "preset" / "none").string() +
+                          " --mode odometry --quiet -n 2");
+  EXPECT_EQ(plain.exit_code, 0) << plain.output;
+  EXPECT_NE(plain.output.find("no --sensor or --config"), std::string::npos) << plain.output;
   Outcome r = run_cli("run " + (root_ / "pcd").string() + " -o " + (root_ / "lv").string() + " --sensor livox");
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.output.find("ring"), std::string::npos) << r.output;
