@@ -144,7 +144,12 @@ void run(const RunArgs& args) {
               std::filesystem::weakly_canonical(args.input).filename();
   prepare_output_dir(out_dir, args.force);
   if (!args.quiet) std::fprintf(stderr, "input: %s\n", source->describe().c_str());
-  if (args.sensor.empty() && args.config_file.empty() && detect_input_kind(args.input) != InputKind::kKitti)
+  const bool kitti_input = detect_input_kind(args.input) == InputKind::kKitti;
+  if (kitti_input && config.odometry.rings.lidar == "hdl64" && config.odometry.preprocess.elevation_correction_deg == 0)
+    std::fprintf(stderr,
+                 "note: an HDL-64E without elevation correction on a KITTI sequence: KITTI's own scans read "
+                 "~0.22 deg low (a steady pitch drift); --sensor kitti corrects that\n");
+  if (args.sensor.empty() && args.config_file.empty() && !kitti_input)
     // The defaults carry KITTI's own calibration error: on another HDL-64E it costs 13x in
     // drift (docs/odometry.md, "Session 19"), on other sensors the ring table is wrong too.
     std::fprintf(stderr,

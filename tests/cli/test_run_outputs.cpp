@@ -141,6 +141,15 @@ TEST_F(RunOutputs, SensorPresetsLoadAndLivoxSaysWhyNot) {
                           " --mode odometry --quiet -n 2");
   EXPECT_EQ(plain.exit_code, 0) << plain.output;
   EXPECT_NE(plain.output.find("no --sensor or --config"), std::string::npos) << plain.output;
+  // A KITTI sequence with the hdl64 preset (no correction of KITTI's elevation error) is told
+  // about --sensor kitti; with the KITTI preset it is not.
+  for (const char* sensor : {"hdl64", "kitti"}) {
+    const Outcome k = run_cli("run " + (root_ / "kitti").string() + " -o " + (root_ / "preset" / "k").string() +
+                              " --mode odometry --quiet -f -n 2 --sensor " + sensor);
+    EXPECT_EQ(k.exit_code, 0) << k.output;
+    EXPECT_EQ(k.output.find("--sensor kitti corrects") != std::string::npos, std::string(sensor) == "hdl64")
+        << sensor << ": " << k.output;
+  }
   Outcome r = run_cli("run " + (root_ / "pcd").string() + " -o " + (root_ / "lv").string() + " --sensor livox");
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.output.find("ring"), std::string::npos) << r.output;
