@@ -1,6 +1,7 @@
 #include "scfloam/io/input_inspect.hpp"
 
 #include <cstdio>
+#include <utility>
 #include <nlohmann/json.hpp>
 
 #include "scfloam/io/bag_source.hpp"
@@ -17,14 +18,16 @@ InputInfo inspect_kitti(const fs::path& dir) {
   InputInfo info;
   info.kind = "KITTI sequence";
   info.scans = seq.size();
-  const Scan first = seq.load(0);
-  const bool pcd = seq.scan_path(0).extension() == ".pcd";
-  if (pcd) {
+  Scan first;
+  if (seq.scan_path(0).extension() == ".pcd") {
+    // Read once: the file gives both its declared fields and the scan.
+    PointCloudFile file = read_pcd(seq.scan_path(0));
     info.kind = "KITTI sequence (PCD scans)";
-    for (const CloudField& f : read_pcd(seq.scan_path(0)).fields)
-      info.point_fields.push_back(f.name + ":" + field_type_name(f.type));
+    for (const CloudField& f : file.fields) info.point_fields.push_back(f.name + ":" + field_type_name(f.type));
+    first = std::move(file.scan);
   } else {
     info.point_fields = {"x:float32", "y:float32", "z:float32", "reflectance:float32"};
+    first = seq.load(0);
   }
   info.points_in_first_scan = first.points.size();
   if (!seq.times().empty()) {

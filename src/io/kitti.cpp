@@ -212,15 +212,11 @@ KittiSequence KittiSequence::open(const fs::path& dir) {
 }
 
 Scan KittiSequence::load(std::size_t index) const {
-  Scan scan;
   const fs::path& path = scan_paths_.at(index);
-  if (path.extension() == ".pcd") {
-    Scan file_scan = read_pcd(path).scan;  // its ring and time fields, when it has them
-    file_scan.timestamp_s = times_.at(index);
-    return file_scan;
-  }
+  Scan scan;
+  if (path.extension() == ".pcd") scan = read_pcd(path).scan;  // with its ring and time fields
+  else scan.points = read_kitti_bin(path);
   scan.timestamp_s = times_.at(index);
-  scan.points = read_kitti_bin(path);
   return scan;
 }
 
