@@ -40,6 +40,10 @@ void print_report(const nlohmann::json& summary) {
               summary["frames"].get<std::size_t>(), summary["keyframes"].get<std::size_t>(),
               summary["wall_s"].get<double>(), summary["fps"].get<double>(),
               summary["peak_rss_mb"].get<double>());
+  const auto& elevation = summary["elevation_correction_deg"];
+  if (elevation["first_frame"].get<double>() != elevation["last_frame"].get<double>())
+    std::printf("elevation correction estimated online: %.3f deg at the first frame, %.3f deg at the last\n",
+                elevation["first_frame"].get<double>(), elevation["last_frame"].get<double>());
   for (const auto& [stage, t] : summary["timing_ms"].items()) {
     if (t["count"].get<std::size_t>() == 0) {
       std::printf("  %-18s (none)\n", stage.c_str());

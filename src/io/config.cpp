@@ -33,6 +33,8 @@ std::vector<Binding> bindings(SlamConfig& c) {
       {pre, "max_range_m", &o.preprocess.max_range_m},
       {pre, "deskew", &o.preprocess.deskew},
       {pre, "elevation_correction_deg", &o.preprocess.elevation_correction_deg},
+      {pre, "online_elevation_calibration", &o.preprocess.online_elevation_calibration},
+      {pre, "elevation_calibration_gain", &o.preprocess.elevation_calibration_gain},
       {ring, "lidar", &o.rings.lidar},
       {ring, "use_ring_field", &o.rings.use_ring_field},
       {ring, "min_points_per_ring", &o.rings.min_points_per_ring},

@@ -3,10 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <optional>
 
 #include "scfloam/error.hpp"
 #include "scfloam/features/deskew.hpp"
 #include "scfloam/features/feature_extractor.hpp"
+#include "scfloam/odometry/elevation_calibration.hpp"
 #include "scfloam/registration/scan_to_map.hpp"
 #include "scfloam/registration/voxel_filter.hpp"
 #include "scfloam/se3.hpp"
@@ -20,7 +22,11 @@ struct Odometry::Impl {
         extractor(c.preprocess, c.rings, c.features),
         map(c.registration, c.map),
         registration(c.registration),
-        rounds(c.registration.outer_iterations_initial) {}
+        rounds(c.registration.outer_iterations_initial) {
+    if (c.preprocess.online_elevation_calibration)
+      elevation.emplace(c.preprocess.elevation_correction_deg,
+                        c.preprocess.elevation_calibration_gain, 1.0);
+  }
 
   OdometryConfig config;
   FeatureExtractor extractor;
@@ -43,6 +49,7 @@ struct Odometry::Impl {
   double last_stamp_s = 0;
   double delta_dt_s = 0;
   Eigen::Vector3d last_cleanup_position = Eigen::Vector3d::Zero();
+  std::optional<ElevationCalibration> elevation;  // when the config estimates the offset
 };
 
 namespace {
@@ -114,6 +121,8 @@ Odometry::Odometry(const OdometryConfig& config) : impl_(std::make_unique<Impl>(
     throw Error("odometry config: need 0 <= min_range_m < max_range_m");
   if (config.registration.outer_iterations < 1 || config.registration.inner_iterations < 1)
     throw Error("odometry config: outer_iterations and inner_iterations must be >= 1");
+  if (p.online_elevation_calibration && !(p.elevation_calibration_gain > 0 && p.elevation_calibration_gain <= 5))
+    throw Error("odometry config: elevation_calibration_gain must be in (0, 5]");
 }
 
 Odometry::~Odometry() = default;
@@ -139,6 +148,8 @@ OdometryResult Odometry::process(const Scan& scan) {
     s.early_points[s.frames] = scan.points;
     s.early_has_ring = scan.has_ring && c.rings.use_ring_field;
   }
+  result.elevation_correction_deg =
+      s.elevation ? s.elevation->correction_deg() : c.preprocess.elevation_correction_deg;
   s.extractor.extract(*points, scan.has_ring && c.rings.use_ring_field, s.raw_edges, s.raw_planes);
   s.edge_filter.filter(s.raw_edges, c.features.edge_leaf_m, result.edges);
   s.plane_filter.filter(s.raw_planes, c.features.plane_leaf_m, result.planes);
@@ -216,6 +227,12 @@ OdometryResult Odometry::process(const Scan& scan) {
     result.weak_directions =
         reg.fallback_applied ? reg.weak_rotation_dirs + reg.weak_translation_dirs : 0;
     s.rounds = std::max(c.registration.outer_iterations, s.rounds - 1);
+    // Not after a gap (an extrapolated start, a candidate search) nor in the first frames,
+    // whose map is one or two scans.
+    if (s.elevation && !gap && s.frames >= 5) {
+      s.extractor.set_elevation_correction_deg(
+          s.elevation->update(registration.plane_matches(), result.T_world_lidar));
+    }
     s.T_delta = orthonormalized(s.T_last.inverse() * result.T_world_lidar);
     s.delta_dt_s = scan.timestamp_s - s.last_stamp_s;
   }

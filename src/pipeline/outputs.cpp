@@ -133,6 +133,8 @@ nlohmann::json make_summary(const ScanSource& source, const RunResult& result) {
   summary["frames"] = result.T_world_lidar.size();
   summary["keyframes"] = result.keyframe_frames.size();
   summary["degenerate_frames"] = result.degenerate_frames;
+  summary["elevation_correction_deg"] = {{"first_frame", result.elevation_correction_first_deg},
+                                         {"last_frame", result.elevation_correction_last_deg}};
   // Frames per number of correspondence rounds: {"2": frames, ...}; extra rounds past the
   // steady-state count show where the motion model was off.
   nlohmann::json rounds = nlohmann::json::object();

@@ -254,6 +254,8 @@ class OdometryStage {
     result.timing_ms["features"].push_back(odom.features_ms);
     result.timing_ms["registration"].push_back(odom.registration_ms);
     if (odom.degenerate) ++result.degenerate_frames;
+    if (result.stamps_s.size() == 1) result.elevation_correction_first_deg = odom.elevation_correction_deg;
+    result.elevation_correction_last_deg = odom.elevation_correction_deg;
     const auto rounds = static_cast<std::size_t>(std::max(0, odom.registration_rounds));
     if (result.registration_rounds.size() <= rounds) result.registration_rounds.resize(rounds + 1, 0);
     ++result.registration_rounds[rounds];

@@ -52,6 +52,9 @@ TEST(CliRun, OdometryOnRealKittiScansWritesEveryOutput) {
     counted += frames.get<int>();
   }
   EXPECT_EQ(counted, 10);
+  // The KITTI preset's fixed elevation correction, unchanged without the online estimate.
+  EXPECT_EQ(summary["elevation_correction_deg"]["first_frame"], 0.22);
+  EXPECT_EQ(summary["elevation_correction_deg"]["last_frame"], 0.22);
   EXPECT_TRUE(summary.contains("accuracy"));  // poses.txt is there: ATE against it
   // The car moves about 5 m forward over these frames (ground truth).
   EXPECT_GT(scfloam::read_kitti_poses(out / "poses_kitti.txt").back().translation().z(), 4.0);

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 
 #include "scfloam/config.hpp"
@@ -66,6 +67,17 @@ TEST(Config, UnknownKeysAndWrongTypesAreErrorsNamingFileAndKey) {
   expect_error_naming(dir / "missing.yaml", "cannot open");
 }
 
+TEST(Config, OnlineElevationCalibrationGainIsChecked) {
+  OdometryConfig c;
+  c.preprocess.online_elevation_calibration = true;
+  for (double bad : {0.0, -0.3, 6.0, std::nan("")}) {
+    c.preprocess.elevation_calibration_gain = bad;
+    EXPECT_THROW(Odometry{c}, Error) << bad;
+  }
+  c.preprocess.elevation_calibration_gain = 0.3;
+  EXPECT_NO_THROW(Odometry{c});
+}
+
 TEST(Config, ShippedPresetsLoadAndConstructTheOdometry) {
   // tests/odometry/this_file.cpp -> repository root.
   const std::filesystem::path config_dir =
@@ -82,6 +94,8 @@ TEST(Config, ShippedPresetsLoadAndConstructTheOdometry) {
     EXPECT_EQ(c.odometry.preprocess.elevation_correction_deg,
               kitti ? SlamConfig{}.odometry.preprocess.elevation_correction_deg : 0.0);
     EXPECT_EQ(c.odometry.preprocess.deskew, !kitti);
+    // The online offset estimate costs accuracy where the start is right (docs/odometry.md).
+    EXPECT_FALSE(c.odometry.preprocess.online_elevation_calibration);
     ++n;
   }
   EXPECT_EQ(n, 6);

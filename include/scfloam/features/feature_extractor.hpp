@@ -42,6 +42,7 @@ class FeatureExtractor {
   void extract(const std::vector<LidarPoint>& points, bool use_ring_field, FeatureCloud& edges,
                FeatureCloud& planes);
   const FeatureStats& stats() const { return stats_; }
+  void set_elevation_correction_deg(double deg) { pre_.elevation_correction_deg = deg; }
 
  private:
   void assign_rings(const std::vector<LidarPoint>& points, bool use_ring_field);

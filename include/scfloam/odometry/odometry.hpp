@@ -32,6 +32,7 @@ struct OdometryResult {
   // Weak directions (rotation + translation) where the pose kept the constant-velocity
   // prediction (RegistrationConfig::degeneracy_fallback); 6 when nothing matched.
   int weak_directions = 0;
+  double elevation_correction_deg = 0;  // applied to this frame's features
 };
 
 class Odometry {

@@ -81,6 +81,9 @@ struct RunResult {
   PoseList odometry_T_world_lidar;   // every frame, as the odometry estimated it
   std::vector<std::size_t> keyframe_frames;
   std::size_t degenerate_frames = 0;
+  // The elevation correction the odometry applied, at the first and the last frame (they
+  // differ only when the config estimates it online).
+  double elevation_correction_first_deg = 0, elevation_correction_last_deg = 0;
   // How many frames ran each number of correspondence rounds (index = rounds).
   std::vector<std::size_t> registration_rounds;
   // Per-stage samples in milliseconds ("features", "registration", ...).
