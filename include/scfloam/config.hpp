@@ -28,7 +28,7 @@ struct PreprocessConfig {
   // Off in every preset: it recovers most of a wrong or unknown offset on 64- and 128-beam
   // sensors (0.32 -> 0.06 % t_err on a simulated city) but wanders by ~0.05 deg where the
   // start is right and by ~0.1 deg on 16/32 beams, which costs more than it gains there
-  // (docs/odometry.md, "Online elevation offset"). The estimate is in summary.json.
+  // (docs/odometry.md, "Session 20"). The estimate is in summary.json.
   bool online_elevation_calibration = false;
   double elevation_calibration_gain = 0.3;  // share of each frame's estimated step applied
 };

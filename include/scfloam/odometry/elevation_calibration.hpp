@@ -1,7 +1,7 @@
 // Online estimate of the LiDAR's common elevation offset (all beams pointing higher or lower
 // than their table says, as KITTI's HDL-64E does by ~0.2 deg). An uncorrected offset turns
 // flat ground into a shallow cone around the sensor; matched against a map of cones seen from
-// earlier poses it becomes a steady pitch drift (docs/odometry.md, "Elevation offset").
+// earlier poses it becomes a steady pitch drift (docs/odometry.md, step 3 and "Session 20").
 #pragma once
 
 #include <Eigen/Geometry>
