@@ -35,9 +35,13 @@ struct PreprocessConfig {
 
 // Which beam each point belongs to.
 struct RingConfig {
-  // Elevation table: "hdl64" (KITTI two-block layout), "hdl32", "vlp16", "os1-64", "os1-128".
+  // Elevation table: "hdl64" (KITTI two-block layout), "hdl32", "vlp16", "os1-64", "os1-128",
+  // or "auto": the beam elevations learned from the first full scan (beam_layout.hpp).
   std::string lidar = "hdl64";
   bool use_ring_field = true;     // take LidarPoint::ring when the scan carries it
+  // When the first scan's beams are distinct but `lidar`'s table does not fit them (two beams
+  // in one ring, or beams outside its field of view), use the learned beams instead.
+  bool adopt_learned_layout = true;
   int min_points_per_ring = 131;  // F-LOAM skips sparser rings
 };
 

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
@@ -199,11 +200,21 @@ FeatureExtractor::FeatureExtractor(const PreprocessConfig& preprocess, const Rin
                                    const FeatureConfig& features)
     : pre_(preprocess),
       feat_(features),
-      model_(parse_lidar_model(rings.lidar)),
+      model_(rings.lidar == "auto" ? LidarModel::hdl64 : parse_lidar_model(rings.lidar)),
+      auto_layout_(rings.lidar == "auto"),
+      adopt_learned_(rings.adopt_learned_layout),
       min_points_per_ring_(rings.min_points_per_ring),
-      beams_(num_beams(model_)) {
+      // "auto": room for any ring field until a layout is learned.
+      beams_(auto_layout_ ? static_cast<int>(kMaxBeams) : num_beams(model_)) {
   if (features.curvature_half_window < 1) throw Error("features: curvature_half_window must be >= 1");
   if (features.sectors_per_ring < 1) throw Error("features: sectors_per_ring must be >= 1");
+  resize_rings(beams_);
+  if (auto_layout_) layout_info_.source = "none";  // until a scan has taught the beams
+  layout_info_.beams = beams_;
+}
+
+void FeatureExtractor::resize_rings(int beams) {
+  beams_ = beams;
   ring_begin_.resize(beams_ + 1);
   candidates_.resize(beams_);
   ring_edges_.resize(beams_);
@@ -212,6 +223,39 @@ FeatureExtractor::FeatureExtractor(const PreprocessConfig& preprocess, const Rin
   ring_resorted_.resize(beams_);
   sort_scratch_.resize(beams_);
   ring_copy_.resize(beams_);
+}
+
+void FeatureExtractor::decide_layout(const std::vector<LidarPoint>& points) {
+  const BeamLayout layout = learn_beam_layout(points, pre_.min_range_m, pre_.max_range_m);
+  if (layout.points_used < kMinLayoutPoints) return;  // decide on a fuller scan
+  layout_decided_ = true;
+  char text[256];
+  if (auto_layout_) {
+    if (!layout.confident) {
+      std::snprintf(text, sizeof text,
+                    "rings.lidar is auto, but the first scan's elevations do not form distinct beams "
+                    "(%.0f %% of %d returns near %zu elevation peaks, 90 %% needed): set rings.lidar "
+                    "(--sensor) to the sensor's model",
+                    100.0 * layout.clustered_fraction, layout.points_used, layout.elevations_deg.size());
+      throw Error(text);
+    }
+    std::snprintf(text, sizeof text, "rings.lidar is auto");
+  } else {
+    if (!adopt_learned_ || !layout.confident) return;
+    const TableFit fit = check_table_fit(model_, layout);
+    if (fit.fits) return;
+    std::snprintf(text, sizeof text,
+                  "the %s ring table does not fit the scans' %zu beams (%d share a ring, %d lie "
+                  "outside its field of view)",
+                  lidar_model_name(model_), layout.elevations_deg.size(), fit.merged_beams, fit.dropped_beams);
+  }
+  learned_.emplace(layout.elevations_deg);
+  resize_rings(learned_->beams());
+  layout_info_.source = "learned";
+  layout_info_.beams = beams_;
+  layout_info_.highest_deg = layout.elevations_deg.front();
+  layout_info_.lowest_deg = layout.elevations_deg.back();
+  layout_info_.reason = text;
 }
 
 void FeatureExtractor::assign_rings(const std::vector<LidarPoint>& points, bool use_ring_field) {
@@ -254,6 +298,15 @@ void FeatureExtractor::assign_rings(const std::vector<LidarPoint>& points, bool 
           ok = _mm_and_ps(ok, _mm_cmple_ps(r2, max4));
           const __m128 el = elevation_deg4(z, _mm_sqrt_ps(r2));
           const __m128 a = select_ps(ok, el, outside);
+          if (learned_) {
+            _mm_store_ps(elevation, a);
+            for (int lane = 0; lane < 4; ++lane) {
+              const int ring = learned_->ring(elevation[lane]);
+              ring_of_[i + lane] = static_cast<std::int16_t>(ring);
+              ++local[static_cast<std::size_t>(ring + 1)];
+            }
+            continue;
+          }
           if (model_ == LidarModel::hdl64) {
             alignas(16) int rings[4];
             _mm_store_si128(reinterpret_cast<__m128i*>(rings), hdl64_rings4(a));
@@ -284,9 +337,9 @@ void FeatureExtractor::assign_rings(const std::vector<LidarPoint>& points, bool 
             ring = (p.ring >= 0 && p.ring < beams_) ? p.ring : -1;
           } else {
             const float a = elevation_deg(p.z, std::sqrt(r2));
-            ring = static_cast<std::int16_t>(model_ == LidarModel::hdl64
-                                                 ? ring_from_elevation_hdl64_deg(a)
-                                                 : ring_from_elevation_deg(model_, a));
+            ring = static_cast<std::int16_t>(learned_                         ? learned_->ring(a)
+                                             : model_ == LidarModel::hdl64 ? ring_from_elevation_hdl64_deg(a)
+                                                                           : ring_from_elevation_deg(model_, a));
           }
         }
         ring_of_[i] = ring;
@@ -445,6 +498,17 @@ void FeatureExtractor::extract(const std::vector<LidarPoint>& points, bool use_r
                                FeatureCloud& edges, FeatureCloud& planes) {
   stats_ = FeatureStats{};
   stats_.input_points = static_cast<int>(points.size());
+  if (use_ring_field) {
+    layout_info_.source = "ring field";
+  } else if (!layout_decided_) {
+    decide_layout(points);
+    if (auto_layout_ && !learned_) {
+      // Too few returns to learn the beams from yet: no features from this scan.
+      edges.clear();
+      planes.clear();
+      return;
+    }
+  }
   assign_rings(points, use_ring_field);
   stats_.kept_points = static_cast<int>(ordered_.size());
   curvature_.resize(ordered_.size());

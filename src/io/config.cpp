@@ -11,6 +11,7 @@
 #include "scfloam/atomic_file.hpp"
 #include "scfloam/config.hpp"
 #include "scfloam/error.hpp"
+#include "scfloam/features/rings.hpp"
 
 namespace scfloam {
 namespace {
@@ -37,6 +38,7 @@ std::vector<Binding> bindings(SlamConfig& c) {
       {pre, "elevation_calibration_gain", &o.preprocess.elevation_calibration_gain},
       {ring, "lidar", &o.rings.lidar},
       {ring, "use_ring_field", &o.rings.use_ring_field},
+      {ring, "adopt_learned_layout", &o.rings.adopt_learned_layout},
       {ring, "min_points_per_ring", &o.rings.min_points_per_ring},
       {feat, "curvature_half_window", &o.features.curvature_half_window},
       {feat, "sectors_per_ring", &o.features.sectors_per_ring},
@@ -206,6 +208,13 @@ void check_ranges(const SlamConfig& c, const std::filesystem::path& path) {
   require(o.preprocess.min_range_m >= 0, "odometry.preprocess.min_range_m", ">= 0");
   require(o.preprocess.max_range_m > o.preprocess.min_range_m, "odometry.preprocess.max_range_m",
           "> min_range_m");
+  if (o.rings.lidar != "auto") {
+    try {
+      parse_lidar_model(o.rings.lidar);
+    } catch (const Error&) {
+      require(false, "odometry.rings.lidar", "auto, hdl64, hdl32, vlp16, os1-64 or os1-128 (got `" + o.rings.lidar + "`)");
+    }
+  }
   require(o.rings.min_points_per_ring >= 0, "odometry.rings.min_points_per_ring", ">= 0");
   require(o.features.curvature_half_window >= 1, "odometry.features.curvature_half_window", ">= 1");
   require(o.features.sectors_per_ring >= 1, "odometry.features.sectors_per_ring", ">= 1");

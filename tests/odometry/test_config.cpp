@@ -64,6 +64,12 @@ TEST(Config, UnknownKeysAndWrongTypesAreErrorsNamingFileAndKey) {
   expect_error_naming(dir / "type.yaml", "odometry.registration.knn");
   write(dir / "bool.yaml", "odometry:\n  preprocess:\n    deskew: 3\n");
   expect_error_naming(dir / "bool.yaml", "odometry.preprocess.deskew");
+  write(dir / "lidar.yaml", "odometry:\n  rings:\n    lidar: hdl-64\n");
+  expect_error_naming(dir / "lidar.yaml", "odometry.rings.lidar");
+  write(dir / "auto.yaml", "odometry:\n  rings:\n    lidar: auto\n    adopt_learned_layout: false\n");
+  const SlamConfig learned = load_config(dir / "auto.yaml");
+  EXPECT_EQ(learned.odometry.rings.lidar, "auto");
+  EXPECT_FALSE(learned.odometry.rings.adopt_learned_layout);
   expect_error_naming(dir / "missing.yaml", "cannot open");
 }
 

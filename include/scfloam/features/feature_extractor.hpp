@@ -5,9 +5,12 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "scfloam/config.hpp"
+#include "scfloam/features/beam_layout.hpp"
 #include "scfloam/features/rings.hpp"
 #include "scfloam/types.hpp"
 
@@ -32,6 +35,16 @@ struct FeatureStats {
   int rings_resorted = 0;  // rings that were not in azimuth order and had to be sorted
 };
 
+// Where the rings came from: "table" (rings.lidar's elevation table), "learned" (the beam
+// elevations of the first full scan, src/features/beam_layout.cpp), "ring field", or "none"
+// (rings.lidar "auto" before a scan had enough returns to learn from).
+struct RingLayoutInfo {
+  std::string source = "table";
+  int beams = 0;
+  double highest_deg = 0, lowest_deg = 0;  // learned layouts
+  std::string reason;                      // why a learned layout replaced the table
+};
+
 class FeatureExtractor {
  public:
   FeatureExtractor(const PreprocessConfig& preprocess, const RingConfig& rings,
@@ -43,8 +56,13 @@ class FeatureExtractor {
                FeatureCloud& planes);
   const FeatureStats& stats() const { return stats_; }
   void set_elevation_correction_deg(double deg) { pre_.elevation_correction_deg = deg; }
+  const RingLayoutInfo& ring_layout() const { return layout_info_; }
 
  private:
+  // Once, on the first scan without a ring field that has enough returns: learn the beams;
+  // with rings.lidar "auto" use them, else use them only where the table does not fit.
+  void decide_layout(const std::vector<LidarPoint>& points);
+  void resize_rings(int beams);
   void assign_rings(const std::vector<LidarPoint>& points, bool use_ring_field);
   void order_ring_by_azimuth(int ring);
   void select_in_ring(int ring);
@@ -52,6 +70,11 @@ class FeatureExtractor {
   PreprocessConfig pre_;
   FeatureConfig feat_;
   LidarModel model_;
+  bool auto_layout_;         // rings.lidar == "auto"
+  bool adopt_learned_;       // rings.adopt_learned_layout
+  bool layout_decided_ = false;
+  std::optional<LearnedRingTable> learned_;
+  RingLayoutInfo layout_info_;
   int min_points_per_ring_;
   int beams_;
 
