@@ -44,6 +44,11 @@ void print_report(const nlohmann::json& summary) {
   if (elevation["first_frame"].get<double>() != elevation["last_frame"].get<double>())
     std::printf("elevation correction estimated online: %.3f deg at the first frame, %.3f deg at the last\n",
                 elevation["first_frame"].get<double>(), elevation["last_frame"].get<double>());
+  const auto& rings = summary["rings"];
+  if (rings["source"] == "learned")
+    std::printf("rings from the scans' own %d beams (%+.2f .. %+.2f deg): %s\n", rings["beams"].get<int>(),
+                rings["highest_deg"].get<double>(), rings["lowest_deg"].get<double>(),
+                rings["reason"].get<std::string>().c_str());
   for (const auto& [stage, t] : summary["timing_ms"].items()) {
     if (t["count"].get<std::size_t>() == 0) {
       std::printf("  %-18s (none)\n", stage.c_str());
@@ -155,7 +160,8 @@ void run(const RunArgs& args) {
                  "~0.22 deg low (a steady pitch drift); --sensor kitti corrects that\n");
   if (args.sensor.empty() && args.config_file.empty() && !kitti_input)
     // The defaults carry KITTI's own calibration error: on another HDL-64E it costs 13x in
-    // drift (docs/odometry.md, "Session 19"), on other sensors the ring table is wrong too.
+    // drift (docs/odometry.md, "Session 19"). A ring table that does not fit the sensor is
+    // replaced by beams learned from the scans, but the leaf sizes and deskew stay KITTI's.
     std::fprintf(stderr,
                  "note: no --sensor or --config: using the defaults, made for KITTI's HDL-64E scans (beams "
                  "raised 0.22 deg, no deskew); for your sensor pass --sensor hdl64 | hdl32 | vlp16 | os1-64 | "

@@ -4,6 +4,7 @@
 #include "command_registry.hpp"
 #include "scfloam/error.hpp"
 #include "scfloam/sim/degenerate.hpp"
+#include "scfloam/sim/sensor.hpp"
 #include "scfloam/sim/simulate.hpp"
 
 namespace {
@@ -65,8 +66,8 @@ scfloam::cli::RegisterCommand reg("simulate", [](CLI::App& app) {
       ->check(CLI::IsMember(scfloam::sim::degenerate_scenario_names()));
   sub->add_option("--kitti-poses,--replay", args->replay, "Replay this KITTI poses file (camera-0) through a city built around it")
       ->check(CLI::ExistingFile);
-  sub->add_option("--sensor", args->config.sensor, "hdl64 | vlp16 | hdl32 | os1-64 | os1-128")
-      ->check(CLI::IsMember({"hdl64", "vlp16", "hdl32", "os1-64", "os1-128"}))->capture_default_str();
+  sub->add_option("--sensor", args->config.sensor, "hdl64 | vlp16 | hdl32 | os1-64 | os1-128 | vlp32c")
+      ->check(CLI::IsMember(scfloam::sim::sensor_preset_names()))->capture_default_str();
   sub->add_flag("--motion-distortion", args->config.motion_distortion, "Cast each column from the pose at its firing time");
   sub->add_option("--scan-format", args->config.scan_format,
                   "velodyne/ as KITTI .bin (x y z reflectance) or binary .pcd with ring and per-point time "

@@ -4,10 +4,12 @@
 #include <utility>
 #include <nlohmann/json.hpp>
 
+#include "scfloam/features/beam_layout.hpp"
 #include "scfloam/io/bag_source.hpp"
 #include "scfloam/io/folder_source.hpp"
 #include "scfloam/io/kitti.hpp"
 #include "scfloam/io/point_cloud_file.hpp"
+#include "scfloam/io/scan_source.hpp"
 
 namespace scfloam {
 namespace fs = std::filesystem;
@@ -48,16 +50,52 @@ InputInfo inspect_kitti(const fs::path& dir) {
   return info;
 }
 
+
+// The beams of the first scan (src/features/beam_layout.cpp) and the ring tables that fit
+// them, so that a user with an unfamiliar sensor knows which --sensor to pass.
+void describe_beams(const Scan& first, InputInfo& info) {
+  if (first.has_ring) return;  // the scan's own rings are used
+  const BeamLayout layout = learn_beam_layout(first.points, 1.0, 200.0);
+  char line[320];
+  if (layout.points_used < kMinLayoutPoints) {
+    std::snprintf(line, sizeof line, "beams: the first scan has only %d usable returns, too few to tell its beams",
+                  layout.points_used);
+  } else if (!layout.confident) {
+    std::snprintf(line, sizeof line,
+                  "beams: elevations blurred (%.0f %% of returns on %zu peaks): rings come from the --sensor "
+                  "table (KITTI's HDL-64E looks like this: --sensor kitti)",
+                  100.0 * layout.clustered_fraction, layout.elevations_deg.size());
+  } else {
+    std::string fitting;
+    for (LidarModel m : {LidarModel::hdl64, LidarModel::hdl32, LidarModel::vlp16, LidarModel::os1_64,
+                         LidarModel::os1_128})
+      if (static_cast<int>(layout.elevations_deg.size()) == num_beams(m) && check_table_fit(m, layout).fits)
+        fitting += std::string(fitting.empty() ? "" : ", ") + lidar_model_name(m);
+    std::snprintf(line, sizeof line,
+                  "beams: %zu distinct elevations, %+.2f .. %+.2f deg (%.1f %% of returns on them); %s",
+                  layout.elevations_deg.size(), layout.elevations_deg.front(), layout.elevations_deg.back(),
+                  100.0 * layout.clustered_fraction,
+                  fitting.empty() ? "no built-in ring table fits: rings are learned from the scans (rings.lidar: auto)"
+                                  : ("ring table of --sensor " + fitting + " fits").c_str());
+  }
+  info.notes.push_back(line);
+}
+
 }  // namespace
 
 InputInfo inspect_input(const fs::path& path, const ScanSourceOptions& options) {
+  InputInfo info;
   switch (detect_input_kind(path)) {
-    case InputKind::kBag: return inspect_bag(path, options);
-    case InputKind::kKitti: return inspect_kitti(path);
-    case InputKind::kScanFolder: return inspect_file_list(list_scan_folder(path), options);
-    case InputKind::kScanFile: return inspect_file_list(single_scan_file(path), options);
+    case InputKind::kBag: info = inspect_bag(path, options); break;
+    case InputKind::kKitti: info = inspect_kitti(path); break;
+    case InputKind::kScanFolder: info = inspect_file_list(list_scan_folder(path), options); break;
+    case InputKind::kScanFile: info = inspect_file_list(single_scan_file(path), options); break;
   }
-  return {};
+  if (info.scans > 0) {
+    const auto source = open_scan_source(path, options);
+    if (source->size() > 0) describe_beams(source->load(0), info);
+  }
+  return info;
 }
 
 std::string input_info_text(const InputInfo& info) {

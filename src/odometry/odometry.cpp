@@ -127,6 +127,8 @@ Odometry::Odometry(const OdometryConfig& config) : impl_(std::make_unique<Impl>(
 
 Odometry::~Odometry() = default;
 
+const RingLayoutInfo& Odometry::ring_layout() const { return impl_->extractor.ring_layout(); }
+
 OdometryResult Odometry::process(const Scan& scan) {
   Impl& s = *impl_;
   const OdometryConfig& c = s.config;

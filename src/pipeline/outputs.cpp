@@ -135,6 +135,13 @@ nlohmann::json make_summary(const ScanSource& source, const RunResult& result) {
   summary["degenerate_frames"] = result.degenerate_frames;
   summary["elevation_correction_deg"] = {{"first_frame", result.elevation_correction_first_deg},
                                          {"last_frame", result.elevation_correction_last_deg}};
+  nlohmann::json rings = {{"source", result.ring_layout.source}, {"beams", result.ring_layout.beams}};
+  if (result.ring_layout.source == "learned") {
+    rings["highest_deg"] = result.ring_layout.highest_deg;
+    rings["lowest_deg"] = result.ring_layout.lowest_deg;
+    rings["reason"] = result.ring_layout.reason;
+  }
+  summary["rings"] = rings;
   // Frames per number of correspondence rounds: {"2": frames, ...}; extra rounds past the
   // steady-state count show where the motion model was off.
   nlohmann::json rounds = nlohmann::json::object();

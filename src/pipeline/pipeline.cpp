@@ -256,6 +256,8 @@ class OdometryStage {
     if (odom.degenerate) ++result.degenerate_frames;
     if (result.stamps_s.size() == 1) result.elevation_correction_first_deg = odom.elevation_correction_deg;
     result.elevation_correction_last_deg = odom.elevation_correction_deg;
+    if (result.stamps_s.size() == 1 || result.ring_layout.source != odometry_.ring_layout().source)
+      result.ring_layout = odometry_.ring_layout();
     const auto rounds = static_cast<std::size_t>(std::max(0, odom.registration_rounds));
     if (result.registration_rounds.size() <= rounds) result.registration_rounds.resize(rounds + 1, 0);
     ++result.registration_rounds[rounds];

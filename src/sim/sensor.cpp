@@ -16,7 +16,9 @@ std::vector<double> linear_beams(double top_deg, double bottom_deg, int count) {
 }
 }  // namespace
 
-std::vector<std::string> sensor_preset_names() { return {"hdl64", "vlp16", "hdl32", "os1-64", "os1-128"}; }
+std::vector<std::string> sensor_preset_names() {
+  return {"hdl64", "vlp16", "hdl32", "os1-64", "os1-128", "vlp32c"};
+}
 
 SensorModel sensor_preset(const std::string& name) {
   SensorModel s;
@@ -47,6 +49,17 @@ SensorModel sensor_preset(const std::string& name) {
   } else if (name == "os1-128") {
     s.elevations_deg = linear_beams(22.5, -22.5, 128);
     s.columns = 1024;  // 1024 x 10 mode
+    s.max_range_m = 120;
+    s.range_noise_m = 0.03;
+  } else if (name == "vlp32c") {
+    // Velodyne VLP-32C (Ultra Puck): 32 beams from +15 to -25 deg, dense around the horizon
+    // (1/3 deg from +1.67 to -4.67) and sparse above and below. No built-in ring table of the
+    // odometry matches it: it exercises rings learned from the scans (beam_layout.hpp).
+    s.elevations_deg = {15.0,   10.333, 7.0,    4.667,  3.333,  2.333,  1.667,  1.333,
+                        1.0,    0.667,  0.333,  0.0,    -0.333, -0.667, -1.0,   -1.333,
+                        -1.667, -2.0,   -2.333, -2.667, -3.0,   -3.333, -3.667, -4.0,
+                        -4.667, -5.333, -6.148, -7.254, -8.843, -11.31, -15.639, -25.0};
+    s.columns = 1800;  // 0.2 deg at 10 Hz
     s.max_range_m = 120;
     s.range_noise_m = 0.03;
   } else {

@@ -55,6 +55,9 @@ TEST(CliRun, OdometryOnRealKittiScansWritesEveryOutput) {
   // The KITTI preset's fixed elevation correction, unchanged without the online estimate.
   EXPECT_EQ(summary["elevation_correction_deg"]["first_frame"], 0.22);
   EXPECT_EQ(summary["elevation_correction_deg"]["last_frame"], 0.22);
+  // KITTI's HDL-64E elevations are blurred (lasers at different heights): F-LOAM's table stays.
+  EXPECT_EQ(summary["rings"]["source"], "table");
+  EXPECT_EQ(summary["rings"]["beams"], 64);
   EXPECT_TRUE(summary.contains("accuracy"));  // poses.txt is there: ATE against it
   // The car moves about 5 m forward over these frames (ground truth).
   EXPECT_GT(scfloam::read_kitti_poses(out / "poses_kitti.txt").back().translation().z(), 4.0);

@@ -51,6 +51,9 @@ TEST(CliInfo, KittiSequence) {
   EXPECT_EQ(j["kind"], "KITTI sequence");
   EXPECT_EQ(j["scans"], 10);
   EXPECT_GT(j["points_in_first_scan"].get<int>(), 100000);
+  bool blurred = false;
+  for (const auto& note : j["notes"]) blurred = blurred || note.get<std::string>().find("beams: elevations blurred") == 0;
+  EXPECT_TRUE(blurred) << j["notes"];
 }
 
 TEST(CliInfo, UnreadableInputsSayWhyAndExitNonZero) {

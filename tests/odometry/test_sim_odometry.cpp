@@ -2,6 +2,7 @@
 // ground truth.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -30,7 +31,10 @@ struct Drift {
   double max_tilt_drift_deg = 0;
 };
 
-Drift run_sim(const sim::SimConfig& cfg, const OdometryConfig& odo_cfg, bool use_rings) {
+// `firing_order`: points column by column, as a raw driver emits them (the simulator writes
+// them beam by beam). `rings`: where the odometry's rings came from, after the run.
+Drift run_sim(const sim::SimConfig& cfg, const OdometryConfig& odo_cfg, bool use_rings,
+              bool firing_order = false, RingLayoutInfo* rings = nullptr) {
   const sim::SensorModel sensor = sim::sensor_for(cfg);
   const sim::Scenario sc = sim::build_scenario(cfg);
   const sim::BeamCalibration calib = sim::draw_beam_calibration(sensor, cfg.seed);
@@ -48,6 +52,12 @@ Drift run_sim(const sim::SimConfig& cfg, const OdometryConfig& odo_cfg, bool use
     Scan scan = sim::render_scan(sc.world, sensor, calib, poses, cfg.seed, k);
     scan.timestamp_s = t;
     scan.has_ring = scan.has_ring && use_rings;
+    if (firing_order) {
+      const double step = sensor.azimuth_step_deg() * M_PI / 180;
+      std::stable_sort(scan.points.begin(), scan.points.end(), [&](const LidarPoint& a, const LidarPoint& b) {
+        return std::lround((std::atan2(a.y, a.x) + M_PI) / step) < std::lround((std::atan2(b.y, b.x) + M_PI) / step);
+      });
+    }
     const Eigen::Isometry3d est = odometry.process(scan).T_world_lidar;
     const Eigen::Isometry3d gt = T0_inv * poses.T_world_lidar;
     if (k > 0) {
@@ -71,11 +81,18 @@ Drift run_sim(const sim::SimConfig& cfg, const OdometryConfig& odo_cfg, bool use
     prev_gt = gt;
     prev_est = est;
   }
+  if (rings) *rings = odometry.ring_layout();
   std::printf("  %s, %zu frames: path %.1f m, end-point error %.3f m (%.3f %%), frame 1 error "
               "%.3f m, max later frame error %.3f m, max tilt drift %.3f deg\n",
               cfg.route.c_str(), sc.frames, d.path_m, d.end_error_m, 100 * d.end_error_m / d.path_m,
               d.first_frame_error_m, d.max_frame_error_m, d.max_tilt_drift_deg);
   return d;
+}
+
+// config/NAME.yaml's odometry section (tests/odometry/this_file.cpp -> repository root).
+OdometryConfig shipped_preset(const std::string& name) {
+  const auto root = std::filesystem::path(__FILE__).parent_path().parent_path().parent_path();
+  return load_config(root / "config" / (name + ".yaml")).odometry;
 }
 
 TEST(SimOdometry, StraightAvenueDriftBelowOnePercent) {
@@ -119,14 +136,35 @@ TEST(SimOdometry, Vlp16PresetHoldsTheAttitudeThroughTurns) {
   cfg.route = "loops";
   cfg.frames = 300;
   cfg.seed = 13;
-  // tests/odometry/this_file.cpp -> repository root.
-  const auto config_dir = std::filesystem::path(__FILE__).parent_path().parent_path().parent_path() / "config";
-  OdometryConfig odo = load_config(config_dir / "vlp16.yaml").odometry;
+  OdometryConfig odo = shipped_preset("vlp16");
   odo.preprocess.deskew = false;  // the scans are not distorted
   const Drift d = run_sim(cfg, odo, /*use_rings=*/true);
   EXPECT_GT(d.path_m, 200.0);
   EXPECT_LT(d.max_tilt_drift_deg, 0.5);
   EXPECT_LT(d.end_error_m / d.path_m, 0.002);
+}
+
+// A sensor none of the built-in ring tables describes (VLP-32C: 1/3 deg beams around the
+// horizon, 9.4 deg apart at the bottom), without a ring field, in firing order, run with the
+// nearest preset (HDL-32E): its table puts two or three beams into one ring, so the odometry
+// learns the beams from the first scan instead (features/beam_layout.hpp).
+TEST(SimOdometry, UnknownBeamLayoutIsLearnedFromTheScans) {
+  sim::SimConfig cfg;
+  cfg.sensor = "vlp32c";
+  cfg.route = "loops";
+  cfg.frames = 150;
+  cfg.seed = 17;
+  OdometryConfig odo = shipped_preset("hdl32");
+  odo.preprocess.deskew = false;  // the scans are not distorted
+  RingLayoutInfo rings;
+  const Drift d = run_sim(cfg, odo, /*use_rings=*/false, /*firing_order=*/true, &rings);
+  EXPECT_EQ(rings.source, "learned");
+  EXPECT_EQ(rings.beams, 32);
+  EXPECT_NEAR(rings.highest_deg, 15.0, 0.02);
+  EXPECT_NEAR(rings.lowest_deg, -25.0, 0.02);
+  EXPECT_GT(d.path_m, 80.0);
+  EXPECT_LT(d.end_error_m / d.path_m, 0.005);
+  EXPECT_LT(d.max_tilt_drift_deg, 0.3);
 }
 
 }  // namespace

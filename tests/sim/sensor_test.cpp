@@ -1,6 +1,8 @@
 // Sensor geometry: beam tables of the presets, range limits, and ranges to a known wall.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <cmath>
 
 #include "scfloam/error.hpp"
@@ -67,6 +69,12 @@ TEST(SensorPresets, OtherLayouts) {
   ASSERT_EQ(os.beams(), 128);
   EXPECT_NEAR(os.elevations_deg.front(), 22.5, 1e-9);
   EXPECT_NEAR(os.elevations_deg.back(), -22.5, 1e-9);
+  // VLP-32C: non-uniform, no ring table of the odometry's matches it (features/beam_layout).
+  const SensorModel v32 = sensor_preset("vlp32c");
+  ASSERT_EQ(v32.beams(), 32);
+  EXPECT_DOUBLE_EQ(v32.elevations_deg.front(), 15);
+  EXPECT_DOUBLE_EQ(v32.elevations_deg.back(), -25);
+  EXPECT_TRUE(std::is_sorted(v32.elevations_deg.rbegin(), v32.elevations_deg.rend()));
   EXPECT_THROW(sensor_preset("hdl65"), Error);
 }
 

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "scfloam/config.hpp"
+#include "scfloam/features/feature_extractor.hpp"
 #include "scfloam/types.hpp"
 
 namespace scfloam {
@@ -43,6 +44,8 @@ class Odometry {
   Odometry& operator=(const Odometry&) = delete;
 
   OdometryResult process(const Scan& scan);
+  // Where the feature extraction's rings come from (a table, learned beams, the ring field).
+  const RingLayoutInfo& ring_layout() const;
 
   // After a loop closure the pipeline moves past keyframes: rebuild the local map from
   // (corrected pose, features) pairs and continue from `T_world_lidar_now`.

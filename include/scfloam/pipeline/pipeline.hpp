@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "scfloam/config.hpp"
+#include "scfloam/features/feature_extractor.hpp"
 #include "scfloam/io/scan_source.hpp"
 #include "scfloam/loop/loop_candidate.hpp"
 #include "scfloam/pipeline/keyframe.hpp"
@@ -84,6 +85,7 @@ struct RunResult {
   // The elevation correction the odometry applied, at the first and the last frame (they
   // differ only when the config estimates it online).
   double elevation_correction_first_deg = 0, elevation_correction_last_deg = 0;
+  RingLayoutInfo ring_layout;  // where the rings came from (the last change of source)
   // How many frames ran each number of correspondence rounds (index = rounds).
   std::vector<std::size_t> registration_rounds;
   // Per-stage samples in milliseconds ("features", "registration", ...).
