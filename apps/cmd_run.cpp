@@ -49,6 +49,11 @@ void print_report(const nlohmann::json& summary) {
     std::printf("rings from the scans' own %d beams (%+.2f .. %+.2f deg): %s\n", rings["beams"].get<int>(),
                 rings["highest_deg"].get<double>(), rings["lowest_deg"].get<double>(),
                 rings["reason"].get<std::string>().c_str());
+  if (rings.contains("cropped_fraction") && rings["cropped_fraction"].get<double>() > 0.1)
+    std::printf("note: the ring table leaves out %d of the scans' %d beams (%.0f %% of the returns); "
+                "rings.lidar: auto would use them\n",
+                rings["cropped_beams"].get<int>(), rings["scan_beams"].get<int>(),
+                100 * rings["cropped_fraction"].get<double>());
   for (const auto& [stage, t] : summary["timing_ms"].items()) {
     if (t["count"].get<std::size_t>() == 0) {
       std::printf("  %-18s (none)\n", stage.c_str());

@@ -139,7 +139,7 @@ TableFit check_table_fit(LidarModel model, const BeamLayout& layout) {
   for (const auto& [ring, n] : beams_per_ring)
     if (n > 1) fit.merged_beams += n;
   fit.dropped_fraction = total > 0 ? static_cast<double>(dropped_returns) / static_cast<double>(total) : 0;
-  fit.fits = fit.merged_beams == 0 && fit.dropped_fraction <= 0.1;
+  fit.fits = fit.merged_beams == 0;
   return fit;
 }
 

@@ -241,9 +241,12 @@ void FeatureExtractor::decide_layout(const std::vector<LidarPoint>& points) {
     }
     std::snprintf(text, sizeof text, "rings.lidar is auto");
   } else {
-    if (!adopt_learned_ || !layout.confident) return;
+    if (!layout.confident) return;
     const TableFit fit = check_table_fit(model_, layout);
-    if (fit.fits) return;
+    layout_info_.scan_beams = static_cast<int>(layout.elevations_deg.size());
+    layout_info_.cropped_beams = fit.dropped_beams;
+    layout_info_.cropped_fraction = fit.dropped_fraction;
+    if (fit.fits || !adopt_learned_) return;
     std::snprintf(text, sizeof text,
                   "the %s ring table does not fit the scans' %zu beams (%d share a ring, %d lie "
                   "outside its field of view)",

@@ -66,16 +66,22 @@ void describe_beams(const Scan& first, InputInfo& info) {
                   "table (KITTI's HDL-64E looks like this: --sensor kitti)",
                   100.0 * layout.clustered_fraction, layout.elevations_deg.size());
   } else {
+    // A preset fits when its table keeps every beam in a ring of its own (KITTI's HDL-64E
+    // table may crop the lowest beams or the top one at its edge: up to 3 of 64).
     std::string fitting;
     for (LidarModel m : {LidarModel::hdl64, LidarModel::hdl32, LidarModel::vlp16, LidarModel::os1_64,
-                         LidarModel::os1_128})
-      if (static_cast<int>(layout.elevations_deg.size()) == num_beams(m) && check_table_fit(m, layout).fits)
+                         LidarModel::os1_128}) {
+      const TableFit fit = check_table_fit(m, layout);
+      if (static_cast<int>(layout.elevations_deg.size()) == num_beams(m) && fit.fits &&
+          fit.dropped_beams * 20 <= num_beams(m))
         fitting += std::string(fitting.empty() ? "" : ", ") + lidar_model_name(m);
+    }
     std::snprintf(line, sizeof line,
                   "beams: %zu distinct elevations, %+.2f .. %+.2f deg (%.1f %% of returns on them); %s",
                   layout.elevations_deg.size(), layout.elevations_deg.front(), layout.elevations_deg.back(),
                   100.0 * layout.clustered_fraction,
-                  fitting.empty() ? "no built-in ring table fits: rings are learned from the scans (rings.lidar: auto)"
+                  fitting.empty() ? "no preset's ring table matches them: rings.lidar: auto uses them (a --sensor table "
+                                    "that puts two of them in one ring is replaced by them anyway)"
                                   : ("ring table of --sensor " + fitting + " fits").c_str());
   }
   info.notes.push_back(line);

@@ -140,6 +140,10 @@ nlohmann::json make_summary(const ScanSource& source, const RunResult& result) {
     rings["highest_deg"] = result.ring_layout.highest_deg;
     rings["lowest_deg"] = result.ring_layout.lowest_deg;
     rings["reason"] = result.ring_layout.reason;
+  } else if (result.ring_layout.scan_beams > 0) {
+    rings["scan_beams"] = result.ring_layout.scan_beams;
+    rings["cropped_beams"] = result.ring_layout.cropped_beams;
+    rings["cropped_fraction"] = result.ring_layout.cropped_fraction;
   }
   summary["rings"] = rings;
   // Frames per number of correspondence rounds: {"2": frames, ...}; extra rounds past the

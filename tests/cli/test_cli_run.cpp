@@ -69,6 +69,32 @@ TEST(CliRun, OdometryOnRealKittiScansWritesEveryOutput) {
   EXPECT_TRUE(fs::exists(out / "summary.json"));
 }
 
+// Rings of a sensor the chosen preset does not describe: a table that merges beams is replaced
+// by the learned beams, one that only crops some is kept and the run says what it leaves out.
+TEST(CliRun, RingsOfAnotherSensorAreLearnedOrTheCropIsReported) {
+  const fs::path dir = scfloam::test::scratch_dir("cli_run_rings");
+  ASSERT_EQ(run_cli("simulate --out " + (dir / "v32").string() + " --frames 4 --sensor vlp32c --quiet").exit_code, 0);
+  ASSERT_EQ(run_cli("simulate --out " + (dir / "v16").string() + " --frames 4 --sensor vlp16 --quiet").exit_code, 0);
+
+  Outcome r = run_cli("run " + (dir / "v32").string() + " --sensor hdl32 -m odometry -q -o " + (dir / "o32").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("rings from the scans' own 32 beams"), std::string::npos) << r.output;
+  auto rings = read_json(dir / "o32" / "summary.json")["rings"];
+  EXPECT_EQ(rings["source"], "learned");
+  EXPECT_EQ(rings["beams"], 32);
+  EXPECT_NEAR(rings["highest_deg"].get<double>(), 15.0, 0.02);
+  EXPECT_NEAR(rings["lowest_deg"].get<double>(), -25.0, 0.02);
+
+  // The defaults' HDL-64E table on a VLP-16: no two beams share a ring, seven are above +2 deg.
+  r = run_cli("run " + (dir / "v16").string() + " -m odometry -q -o " + (dir / "o16").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("leaves out 7 of the scans' 16 beams"), std::string::npos) << r.output;
+  rings = read_json(dir / "o16" / "summary.json")["rings"];
+  EXPECT_EQ(rings["source"], "table");
+  EXPECT_EQ(rings["scan_beams"], 16);
+  EXPECT_EQ(rings["cropped_beams"], 7);
+}
+
 TEST(CliRun, BadInputGivesAClearErrorAndExitCode) {
   const fs::path dir = scfloam::test::scratch_dir("cli_run_bad");
   Outcome r = run_cli("run " + (dir / "missing").string() + " --out " + (dir / "o").string());

@@ -146,7 +146,7 @@ TEST(TableFit, EachTableFitsItsOwnSensorAndNotAnother) {
   EXPECT_GT(vlp32c_in_hdl32.merged_beams, 10);
   // A KITTI-like HDL-64E (+2 .. -24.9 deg): F-LOAM's table ends at -24.33 and drops the two
   // lowest beams; the top beam, exactly at its +2 deg edge, may go too (~5 % of the returns
-  // here): it still fits.
+  // here). No two beams share a ring: it fits.
   std::vector<double> hdl64 = uniform_fan(2.0, 2.0 - 31.0 / 3.0, 32), lower = uniform_fan(-8.87, -24.9, 32);
   hdl64.insert(hdl64.end(), lower.begin(), lower.end());
   const TableFit own = check_table_fit(LidarModel::hdl64, layout_of(hdl64));
@@ -155,10 +155,17 @@ TEST(TableFit, EachTableFitsItsOwnSensorAndNotAnother) {
   EXPECT_GE(own.dropped_beams, 2);
   EXPECT_LE(own.dropped_beams, 3);
   EXPECT_LT(own.dropped_fraction, 0.1);
-  // An OS1-128 in the HDL-64E table: the upper half is outside its field of view.
+  // An OS1-128 in the HDL-64E table: 0.35 deg beams in its 0.5 deg lower block merge, and
+  // the upper half is outside its field of view.
   const TableFit os128 = check_table_fit(LidarModel::hdl64, layout_of(uniform_fan(22.5, -22.5, 128)));
   EXPECT_FALSE(os128.fits);
+  EXPECT_GT(os128.merged_beams, 0);
   EXPECT_GT(os128.dropped_fraction, 0.3);
+  // A VLP-16 in the HDL-64E table: its 2 deg beams never share a ring, the seven above +2 deg
+  // are cropped: it fits (cropping is reported, not replaced).
+  const TableFit vlp16 = check_table_fit(LidarModel::hdl64, layout_of(uniform_fan(15, -15, 16)));
+  EXPECT_TRUE(vlp16.fits);
+  EXPECT_EQ(vlp16.dropped_beams, 7);
 }
 
 // Features from learned rings equal those from the ring field itself.

@@ -55,9 +55,10 @@ class LearnedRingTable {
 };
 
 // Whether a built-in ring table serves the learned layout: no two beams fall into one of its
-// rings (in firing order their points would interleave on one "ring", and every point would
-// look like a corner), and beams outside its field of view hold ≤ 10 % of the returns (F-LOAM's
-// HDL-64E table ends at -24.33 deg and drops KITTI's two lowest beams, ~4 % of the returns).
+// rings (in firing order their points would interleave on one "ring", a zigzag that reads as
+// curvature everywhere and buries the real corners). Beams outside its field of view are only
+// counted: cropping is a table's choice (F-LOAM's HDL-64E table ends at -24.33 deg and drops
+// KITTI's two lowest beams), and using them measured no better (docs/odometry.md, "Session 21").
 struct TableFit {
   bool fits = true;
   int merged_beams = 0;   // beams sharing a ring with another beam

@@ -43,6 +43,10 @@ struct RingLayoutInfo {
   int beams = 0;
   double highest_deg = 0, lowest_deg = 0;  // learned layouts
   std::string reason;                      // why a learned layout replaced the table
+  // Tables kept on scans whose beams were learned: the beams learned, and those outside the
+  // table's field of view (not used) with their share of the returns.
+  int scan_beams = 0, cropped_beams = 0;
+  double cropped_fraction = 0;
 };
 
 class FeatureExtractor {
