@@ -18,6 +18,7 @@ namespace scfloam {
 namespace {
 
 constexpr std::size_t kMaxBeams = 128;  // the largest model (OS1-128)
+constexpr int kMaxRingField = 1024;     // rings a ring field may number (larger values are dropped)
 
 // atan for |x| <= 1, |error| <= 1e-5 rad (Abramowitz & Stegun 4.4.47): 5x cheaper than atan2,
 // and 6e-4 deg is far below the 1/3 deg beam spacing.
@@ -502,7 +503,13 @@ void FeatureExtractor::extract(const std::vector<LidarPoint>& points, bool use_r
   stats_ = FeatureStats{};
   stats_.input_points = static_cast<int>(points.size());
   if (use_ring_field) {
+    // The ring field decides how many rings there are: a 32-beam driver's rings under a
+    // 16-beam preset would otherwise lose rings 16-31 (values beyond kMaxRingField are dropped).
+    int highest = -1;
+    for (const LidarPoint& p : points) highest = std::max(highest, static_cast<int>(p.ring));
+    if (highest >= beams_) resize_rings(std::min(highest, kMaxRingField - 1) + 1);
     layout_info_.source = "ring field";
+    layout_info_.beams = beams_;
   } else if (!layout_decided_) {
     decide_layout(points);
     if (auto_layout_ && !learned_) {

@@ -235,6 +235,21 @@ TEST(FeatureExtractorLayout, ATableThatDoesNotFitIsReplacedByTheLearnedBeams) {
   EXPECT_EQ(p_adopted.size(), p_field.size());
 }
 
+// A 32-beam driver's ring field under a 16-beam preset: all 32 rings are used, as under a
+// 128-beam one (before, rings 16-31 were dropped).
+TEST(FeatureExtractorLayout, RingFieldBeyondThePresetsBeamsIsKept) {
+  const auto scan = room_scan(kVlp32c);
+  FeatureCloud e16, p16, e128, p128;
+  RingLayoutInfo info;
+  extract("vlp16", true, scan, true, e16, p16, &info);
+  EXPECT_EQ(info.source, "ring field");
+  EXPECT_EQ(info.beams, 32);
+  extract("os1-128", true, scan, true, e128, p128);
+  ASSERT_FALSE(e128.empty());
+  EXPECT_EQ(e16, e128);
+  EXPECT_EQ(p16, p128);
+}
+
 TEST(FeatureExtractorLayout, ATableThatFitsStays) {
   FeatureCloud e, p;
   RingLayoutInfo info;
