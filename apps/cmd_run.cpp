@@ -90,12 +90,13 @@ std::filesystem::path preset_path(const std::string& sensor) {
                 "or rings from the elevation of a multi-beam fan) and takes curvature along each ring; a "
                 "Livox non-repetitive pattern has neither (docs/inputs.md)");
   const char* names[][2] = {{"kitti", "kitti-hdl64"}, {"hdl64", "hdl64"}, {"hdl32", "hdl32"},
-                            {"vlp16", "vlp16"}, {"os1-64", "os1-64"}, {"os1-128", "os1-128"}};
+                            {"vlp16", "vlp16"}, {"os1-64", "os1-64"}, {"os1-128", "os1-128"},
+                            {"auto", "auto"}};
   std::string file;
   for (const auto& n : names)
     if (sensor == n[0]) file = std::string(n[1]) + ".yaml";
   if (file.empty())
-    throw Error("--sensor: unknown sensor '" + sensor + "' (kitti, hdl64, hdl32, vlp16, os1-64, os1-128, livox)");
+    throw Error("--sensor: unknown sensor '" + sensor + "' (kitti, hdl64, hdl32, vlp16, os1-64, os1-128, auto, livox)");
   std::vector<std::filesystem::path> dirs;
   if (const char* env = std::getenv("SCFLOAM_CONFIG_DIR")) dirs.emplace_back(env);
   std::error_code ec;
@@ -170,7 +171,7 @@ void run(const RunArgs& args) {
     std::fprintf(stderr,
                  "note: no --sensor or --config: using the defaults, made for KITTI's HDL-64E scans (beams "
                  "raised 0.22 deg, no deskew); for your sensor pass --sensor hdl64 | hdl32 | vlp16 | os1-64 | "
-                 "os1-128\n");
+                 "os1-128, or auto for another spinning sensor\n");
 
   RunOptions options;
   options.mode = *mode;
@@ -205,7 +206,8 @@ RegisterCommand reg("run", [](CLI::App& app) {
   sub->add_option("-n,--frames", args->frames, "Process only the first N scans");
   sub->add_option("-s,--sensor", args->sensor,
                   "Sensor preset: kitti (the defaults: KITTI's HDL-64E scans) | hdl64 | hdl32 | vlp16 | os1-64 | "
-                  "os1-128 (config/); --config overrides its keys");
+                  "os1-128 | auto (another spinning sensor: beams learned from the scans) (config/); --config "
+                  "overrides its keys");
   sub->add_option("--topic", args->topic, "Bags: the PointCloud2 topic (auto when there is only one)");
   sub->add_option("--timestamps", args->timestamps, "Folders: file with one stamp (s) per scan, in scan order");
   sub->add_option("--frame", args->frame, "KITTI trajectories in lidar | camera | auto (camera when the input has Tr)");

@@ -417,7 +417,13 @@ RunResult run_slam(const ScanSource& source, const SlamConfig& base_config,
       threads->wait_for_lag(index);
       wait_lag_ms.push_back(lag_watch.elapsed_ms());
     }
-    KeyframePtr kf = odometry.process(index, scan, result);
+    KeyframePtr kf;
+    try {
+      kf = odometry.process(index, scan, result);
+    } catch (const Error& e) {
+      // Name the input and the scan: the odometry does not know where its scan came from.
+      throw Error(source.describe() + ", scan " + std::to_string(index) + ": " + e.what());
+    }
     if (kf && options.live) options.live->keyframes.fetch_add(1, std::memory_order_relaxed);
     if (kf && loops) {
       if (threads) {

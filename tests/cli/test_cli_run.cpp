@@ -85,6 +85,13 @@ TEST(CliRun, RingsOfAnotherSensorAreLearnedOrTheCropIsReported) {
   EXPECT_NEAR(rings["highest_deg"].get<double>(), 15.0, 0.02);
   EXPECT_NEAR(rings["lowest_deg"].get<double>(), -25.0, 0.02);
 
+  // --sensor auto: the same beams, learned whatever a table would say.
+  r = run_cli("run " + (dir / "v32").string() + " --sensor auto -m odometry -q -o " + (dir / "oauto").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  rings = read_json(dir / "oauto" / "summary.json")["rings"];
+  EXPECT_EQ(rings["source"], "learned");
+  EXPECT_EQ(rings["beams"], 32);
+
   // The defaults' HDL-64E table on a VLP-16: no two beams share a ring, seven are above +2 deg.
   r = run_cli("run " + (dir / "v16").string() + " -m odometry -q -o " + (dir / "o16").string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
@@ -93,6 +100,15 @@ TEST(CliRun, RingsOfAnotherSensorAreLearnedOrTheCropIsReported) {
   EXPECT_EQ(rings["source"], "table");
   EXPECT_EQ(rings["scan_beams"], 16);
   EXPECT_EQ(rings["cropped_beams"], 7);
+}
+
+// KITTI's own HDL-64E scans have blurred elevations: --sensor auto refuses them and says why.
+TEST(CliRun, AutoRingsOnKittiScansStopWithAnError) {
+  SCFLOAM_SHARED_DATA_OR_SKIP(seq, "kitti/scans/05");
+  const fs::path out = scfloam::test::scratch_dir("cli_run_auto_kitti");
+  const Outcome r = run_cli("run " + seq.string() + " --sensor auto -m odometry -q -o " + out.string());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("do not form distinct beams"), std::string::npos) << r.output;
 }
 
 TEST(CliRun, BadInputGivesAClearErrorAndExitCode) {

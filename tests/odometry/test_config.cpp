@@ -90,7 +90,7 @@ TEST(Config, ShippedPresetsLoadAndConstructTheOdometry) {
       std::filesystem::path(__FILE__).parent_path().parent_path().parent_path() / "config";
   int n = 0;
   for (const char* name :
-       {"kitti-hdl64.yaml", "hdl64.yaml", "vlp16.yaml", "hdl32.yaml", "os1-64.yaml", "os1-128.yaml"}) {
+       {"kitti-hdl64.yaml", "hdl64.yaml", "vlp16.yaml", "hdl32.yaml", "os1-64.yaml", "os1-128.yaml", "auto.yaml"}) {
     SCOPED_TRACE(name);
     const SlamConfig c = load_config(config_dir / name);
     EXPECT_NO_THROW(Odometry{c.odometry});
@@ -104,7 +104,7 @@ TEST(Config, ShippedPresetsLoadAndConstructTheOdometry) {
     EXPECT_FALSE(c.odometry.preprocess.online_elevation_calibration);
     ++n;
   }
-  EXPECT_EQ(n, 6);
+  EXPECT_EQ(n, 7);
 }
 
 }  // namespace
