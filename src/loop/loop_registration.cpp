@@ -16,6 +16,7 @@ RegistrationConfig coarse_registration(const LoopRegistrationConfig& config,
                                        const RegistrationConfig& registration) {
   RegistrationConfig coarse = registration;
   coarse.max_neighbor_dist_m = std::max(config.coarse_radius_m, registration.max_neighbor_dist_m);
+  coarse.edge_max_residual_m = 0;  // the start may be metres off: every line within reach counts
   return coarse;
 }
 
@@ -131,12 +132,15 @@ LoopMatch register_loop_features(const KeyframeView& current, const LoopSubmap& 
   const Eigen::Isometry3d T_anchor_loop = T_world_anchor.inverse() * T_world_loop;
   ScanToMapRegistration coarse_solver(coarse_registration(config, registration));
   ScanToMapRegistration fine_solver(registration);
-  // Counts the check's matches at the solved pose, when its flatness test differs from the
-  // solve's (otherwise the solve's own counts are the check's).
+  // Counts the check's matches at the solved pose when its tests differ from the solve's
+  // (otherwise the solve's own counts are the check's). The check counts F-LOAM's matches
+  // (0.2 m flatness, no residual cut for edges): its thresholds were measured with
+  // those, whatever stricter tests the solve uses.
   std::optional<ScanToMapRegistration> check_solver;
-  if (config.check_plane_max_dist_m != registration.plane_max_dist_m) {
+  if (config.check_plane_max_dist_m != registration.plane_max_dist_m || registration.edge_max_residual_m != 0) {
     RegistrationConfig check_registration = registration;
     check_registration.plane_max_dist_m = config.check_plane_max_dist_m;
+    check_registration.edge_max_residual_m = 0;
     check_solver.emplace(check_registration);
   }
   const std::vector<Eigen::Isometry3d> guesses =

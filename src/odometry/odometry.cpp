@@ -101,6 +101,7 @@ Eigen::Isometry3d coarse_alignment(const OdometryConfig& c, const FeatureCloud& 
   RegistrationConfig coarse = c.registration;
   coarse.max_neighbor_dist_m = c.registration.coarse_neighbor_dist_m;
   coarse.degeneracy_fallback = false;
+  coarse.edge_max_residual_m = 0;  // the start may be a metre off: every line within reach counts
   LocalMapConfig coarse_map = c.map;
   // Cells are the search radius wide: keep the density of the fine map's cells.
   const double area_ratio = std::pow(coarse.max_neighbor_dist_m / c.registration.max_neighbor_dist_m, 2);

@@ -37,14 +37,21 @@ TEST(ScanToMap, RecoversAKnownMotionOfKitti05Frame0) {
   Eigen::Matrix<double, 6, 1> xi;
   xi << 0.0, 0.0, 1.0 * M_PI / 180, 0.3, -0.1, 0.05;
   const Eigen::Isometry3d T_init = left_perturb(xi, Eigen::Isometry3d::Identity());
-  const RegistrationResult r = register_features(f.edges, f.planes, map, T_init, c.registration, 12);
-  EXPECT_LT(r.T_world_lidar.translation().norm(), 0.01);
-  EXPECT_LT(rotation_angle_rad(r.T_world_lidar.linear()) * 180 / M_PI, 0.02);
-  EXPECT_GT(r.plane_matches, 1000);
-  // 8 neighbours (the default) must lie on one line within 1 m: 205 edges match here, where
-  // F-LOAM's 5 matched over 300: the more neighbours, the stricter the line test.
-  EXPECT_GT(r.edge_matches, 150);
-  EXPECT_FALSE(r.degenerate);
+  for (const double max_residual_m : {0.0, 0.1}) {
+    SCOPED_TRACE(max_residual_m);
+    RegistrationConfig rc = c.registration;
+    rc.edge_max_residual_m = max_residual_m;
+    const RegistrationResult r = register_features(f.edges, f.planes, map, T_init, rc, 12);
+    EXPECT_LT(r.T_world_lidar.translation().norm(), 0.01);
+    EXPECT_LT(rotation_angle_rad(r.T_world_lidar.linear()) * 180 / M_PI, 0.02);
+    EXPECT_GT(r.plane_matches, 1000);
+    // 8 neighbours (the default) must lie on one line within 1 m: 205 edges match here without
+    // the residual cut, where F-LOAM's 5 matched over 300: the more neighbours, the stricter
+    // the line test. The query edges are 0.4 m voxel centroids of edge points, and more than
+    // half of them lie over 0.1 m from the line they find: 85 remain.
+    EXPECT_GT(r.edge_matches, max_residual_m == 0 ? 150 : 60);
+    EXPECT_FALSE(r.degenerate);
+  }
 }
 
 TEST(ScanToMap, Kitti05FramePairMatchesGroundTruth) {
@@ -110,6 +117,35 @@ TEST(ScanToMap, PlaneSpreadRatioRejectsARingTraceButKeepsTheGround) {
   // farther than max_neighbor_dist_m).
   EXPECT_EQ(all, static_cast<int>(planes.size()) - 2 * 4);
   EXPECT_EQ(spread, static_cast<int>(ground.size()));  // on: only the ground does
+}
+
+TEST(ScanToMap, EdgeResidualCutRefusesAFarLineButKeepsANearOne) {
+  // A trunk's face mapped from one side (a vertical line of points) and the scan's points on
+  // its other face, 0.3 m away: within the search radius, so F-LOAM matches them to the line.
+  FeatureCloud map_edges, near, far;
+  for (int i = -10; i <= 10; ++i) {
+    const float z = 0.1f * static_cast<float>(i);
+    map_edges.emplace_back(5.0f, 0.0f, z);
+    if (i > -5 && i < 5) {
+      near.emplace_back(5.05f, 0.0f, z + 0.05f);
+      far.emplace_back(5.3f, 0.0f, z + 0.05f);
+    }
+  }
+  OdometryConfig c;
+  c.map.edge_spacing_m = 0.0;  // keep every point: the neighbourhoods are the ones built here
+  FeatureMap map(c.registration, c.map);
+  map.insert(map_edges, {}, Eigen::Isometry3d::Identity());
+  const auto edge_matches = [&](const FeatureCloud& queries, double max_residual_m) {
+    c.registration.edge_max_residual_m = max_residual_m;
+    ScanToMapRegistration registration(c.registration);
+    return registration.count_matches(queries, {}, map, Eigen::Isometry3d::Identity()).first;
+  };
+  const int n = static_cast<int>(near.size());
+  EXPECT_EQ(edge_matches(near, 0.0), n);
+  EXPECT_EQ(edge_matches(near, 0.1), n);
+  EXPECT_EQ(edge_matches(far, 0.0), n);  // F-LOAM's tests alone take the other face
+  EXPECT_EQ(edge_matches(far, 0.1), 0);
+  EXPECT_EQ(edge_matches(far, 0.35), n);
 }
 
 TEST(ScanToMap, CountMatchesAtTheSolutionAreAlignsAndFollowTheFlatnessTest) {
