@@ -78,8 +78,8 @@ struct RegistrationConfig {
   double plane_max_dist_m = 0.1;     // every neighbour within this of the fitted plane (F-LOAM: 0.2)
   // An edge match is dropped when the point lies farther than this from its line (0 = never,
   // as F-LOAM). Coarse passes, whose start is farther off, do not apply it. Opt-in: 0.1 takes
-  // 25-60 % off t_err on simulated HDL-64 drives but moves one real KITTI 08 frame past its
-  // test's bound (docs/odometry.md, "Session 22").
+  // 5-60 % off t_err on simulated HDL-64 drives (other sensors: within 0.001) but moves one
+  // real KITTI 08 frame past its test's bound (docs/odometry.md, "Session 22").
   double edge_max_residual_m = 0.0;
   // Reject a plane match whose neighbours spread along one line only (second covariance
   // eigenvalue < ratio * largest): a single ring's trace fits any plane through it (0 = off).

@@ -131,8 +131,8 @@ void ScanToMapRegistration::find_matches(const FeatureCloud& edges, const Featur
           // A point this far from the line it found is not on it: the line is another face
           // of a trunk or pole, or a loose cluster, seen from the viewpoints the map was built
           // from. Under the Huber loss each such match still pulls with full force, towards
-          // those viewpoints: on simulated drives the pose lagged behind by 0.02 % of the
-          // distance (docs/odometry.md, "Session 22").
+          // those viewpoints: on simulated drives the pose lagged behind by up to 0.02 % of
+          // the distance (docs/odometry.md, "Session 22").
           const Eigen::Vector3d d = s.eigenvectors.col(2);
           const Eigen::Vector3d v = q.cast<double>() - s.mean;
           if ((v - v.dot(d) * d).squaredNorm() > config_.edge_max_residual_m * config_.edge_max_residual_m)
