@@ -81,6 +81,13 @@ struct RegistrationConfig {
   // 5-60 % off t_err on simulated HDL-64 drives (other sensors: within 0.001) but moves one
   // real KITTI 08 frame past its test's bound (docs/odometry.md, "Session 22").
   double edge_max_residual_m = 0.0;
+  // An edge matches only map points seen from within this horizontal angle of its own viewing
+  // direction (0 = any, as F-LOAM): a pole's or trunk's silhouette seen from elsewhere is
+  // another line, and matched to it the pose slides towards the map's viewpoints (behind). The
+  // local map then keeps points of different views side by side. Loop registration, whose
+  // keyframes come from other directions, never applies it. Off in the 16/32-beam presets,
+  // where it gained nothing after loops (docs/odometry.md, "Session 23").
+  double edge_view_tolerance_deg = 20.0;
   // Reject a plane match whose neighbours spread along one line only (second covariance
   // eigenvalue < ratio * largest): a single ring's trace fits any plane through it (0 = off).
   double plane_min_spread_ratio = 0.0;

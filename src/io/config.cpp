@@ -55,6 +55,7 @@ std::vector<Binding> bindings(SlamConfig& c) {
       {reg, "edge_line_ratio", &o.registration.edge_line_ratio},
       {reg, "plane_max_dist_m", &o.registration.plane_max_dist_m},
       {reg, "edge_max_residual_m", &o.registration.edge_max_residual_m},
+      {reg, "edge_view_tolerance_deg", &o.registration.edge_view_tolerance_deg},
       {reg, "plane_min_spread_ratio", &o.registration.plane_min_spread_ratio},
       {reg, "huber_delta_m", &o.registration.huber_delta_m},
       {reg, "inner_iterations", &o.registration.inner_iterations},
@@ -232,6 +233,8 @@ void check_ranges(const SlamConfig& c, const std::filesystem::path& path) {
   require(o.registration.max_neighbor_dist_m > 0, "odometry.registration.max_neighbor_dist_m", "> 0");
   require(o.registration.plane_max_dist_m > 0, "odometry.registration.plane_max_dist_m", "> 0");
   require(o.registration.edge_max_residual_m >= 0, "odometry.registration.edge_max_residual_m", ">= 0 (0 = off)");
+  require(o.registration.edge_view_tolerance_deg >= 0 && o.registration.edge_view_tolerance_deg < 180,
+          "odometry.registration.edge_view_tolerance_deg", "in [0, 180) (0 = off)");
   require(c.loop_registration.check_plane_max_dist_m > 0, "loop_registration.check_plane_max_dist_m",
           "> 0");
   require(o.registration.inner_iterations >= 1, "odometry.registration.inner_iterations", ">= 1");

@@ -20,6 +20,13 @@ RegistrationConfig coarse_registration(const LoopRegistrationConfig& config,
   return coarse;
 }
 
+// Keyframes of a loop are seen from other directions than the current one (and the submap is
+// stored in its anchor's frame): no viewing-direction filter.
+RegistrationConfig without_view_filter(RegistrationConfig registration) {
+  registration.edge_view_tolerance_deg = 0;
+  return registration;
+}
+
 LocalMapConfig coarse_map_config(const LoopRegistrationConfig& config,
                                  const RegistrationConfig& registration,
                                  const LocalMapConfig& map_config) {
@@ -53,9 +60,9 @@ LoopSubmap::LoopSubmap(const std::vector<KeyframeView>& keyframes, std::size_t a
     : first_(first_keyframe),
       last_(first_keyframe + keyframes.size() - 1),
       anchor_(first_keyframe + anchor),
-      coarse_registration_(coarse_registration(config, registration)),
+      coarse_registration_(coarse_registration(config, without_view_filter(registration))),
       coarse_map_(coarse_map_config(config, registration, map_config)),
-      fine_(registration, map_config) {
+      fine_(without_view_filter(registration), map_config) {
   const Eigen::Isometry3d T_anchor_world = keyframes.at(anchor).T_world_lidar.inverse();
   const auto append = [](const FeatureCloud* cloud, const Eigen::Isometry3f& T, FeatureCloud& out) {
     if (cloud == nullptr) return;
@@ -119,7 +126,7 @@ LoopMatch register_loop_features(const KeyframeView& current, const LoopSubmap& 
                                  const Eigen::Isometry3d& T_world_loop, double sc_yaw_rad,
                                  const LoopRegistrationConfig& config,
                                  const RegistrationConfig& odometry_registration) {
-  RegistrationConfig registration = odometry_registration;
+  RegistrationConfig registration = without_view_filter(odometry_registration);
   registration.knn = config.knn;
   LoopMatch best;
   best.reason = "no features";

@@ -102,6 +102,7 @@ Eigen::Isometry3d coarse_alignment(const OdometryConfig& c, const FeatureCloud& 
   coarse.max_neighbor_dist_m = c.registration.coarse_neighbor_dist_m;
   coarse.degeneracy_fallback = false;
   coarse.edge_max_residual_m = 0;  // the start may be a metre off: every line within reach counts
+  coarse.edge_view_tolerance_deg = 0;
   LocalMapConfig coarse_map = c.map;
   // Cells are the search radius wide: keep the density of the fine map's cells.
   const double area_ratio = std::pow(coarse.max_neighbor_dist_m / c.registration.max_neighbor_dist_m, 2);

@@ -18,7 +18,8 @@
 namespace scfloam {
 
 FeatureMap::FeatureMap(const RegistrationConfig& registration, const LocalMapConfig& map)
-    : edges_(registration.max_neighbor_dist_m, map.edge_spacing_m, map.max_points_per_cell),
+    : edges_(registration.max_neighbor_dist_m, map.edge_spacing_m, map.max_points_per_cell,
+             registration.edge_view_tolerance_deg * M_PI / 180.0),
       planes_(registration.max_neighbor_dist_m, map.plane_spacing_m, map.max_points_per_cell) {}
 
 void FeatureMap::insert(const FeatureCloud& edges_lidar, const FeatureCloud& planes_lidar,
@@ -114,6 +115,8 @@ void ScanToMapRegistration::find_matches(const FeatureCloud& edges, const Featur
   }
 
   const std::size_t n_edges = edges.size(), total = edges.size() + planes.size();
+  const bool view_filter = config_.edge_view_tolerance_deg > 0 && map.edges().stores_views();
+  const Eigen::Vector3f sensor = T.translation();
   auto work = [&](const tbb::blocked_range<std::size_t>& range) {
     VoxelMap::Neighbors nb;
     for (std::size_t r = range.begin(); r != range.end(); ++r) {
@@ -123,7 +126,12 @@ void ScanToMapRegistration::find_matches(const FeatureCloud& edges, const Featur
         if (!first_round && (q - edge_query_[i]).squaredNorm() < refresh2) continue;
         edge_query_[i] = q;
         edge_ok_[i] = 0;
-        map.edges().knn(q, k, radius, nb);
+        if (view_filter) {
+          const VoxelMap::View view = VoxelMap::view_of(sensor, q);
+          map.edges().knn(q, k, radius, nb, &view);
+        } else {
+          map.edges().knn(q, k, radius, nb);
+        }
         if (nb.count < k) continue;
         const LocalShape s = local_shape(nb);
         if (!(s.eigenvalues[2] > config_.edge_line_ratio * s.eigenvalues[1])) continue;

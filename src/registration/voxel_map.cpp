@@ -1,6 +1,7 @@
 #include "scfloam/registration/voxel_map.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "scfloam/error.hpp"
 
@@ -17,18 +18,36 @@ VoxelMap::VoxelMap(double max_query_radius_m, double min_spacing_m, int max_poin
   index_.reset(1024);
 }
 
+VoxelMap::VoxelMap(double max_query_radius_m, double min_spacing_m, int max_points_per_cell,
+                   double view_tolerance_rad)
+    : VoxelMap(max_query_radius_m, min_spacing_m, max_points_per_cell) {
+  if (!(view_tolerance_rad >= 0)) throw Error("voxel map: view tolerance must be >= 0");
+  if (view_tolerance_rad > 0)
+    view_tolerance_ = static_cast<View>(
+        std::clamp(std::lround(view_tolerance_rad / (2 * M_PI) * 65536.0), 1l, 32767l));
+}
+
+VoxelMap::View VoxelMap::view_of(const Eigen::Vector3f& sensor, const Eigen::Vector3f& point) {
+  const float az = std::atan2(point.y() - sensor.y(), point.x() - sensor.x());
+  return static_cast<View>(static_cast<std::int32_t>(std::lround(az * (65536.0 / (2 * M_PI)))) & 0xffff);
+}
+
 std::size_t VoxelMap::insert(const FeatureCloud& points_lidar,
                              const Eigen::Isometry3d& T_world_lidar) {
   const Eigen::Isometry3f T = T_world_lidar.cast<float>();
+  const Eigen::Vector3f sensor = T.translation();
+  const bool views = stores_views();
   std::size_t stored = 0;
   for (const auto& pl : points_lidar) {
     const Eigen::Vector3f p = T * pl;
+    const View view = views ? view_of(sensor, p) : View{0};
     const Eigen::Vector3i c = voxel_coords(p, inv_cell_size_);
     const auto id = static_cast<std::uint32_t>(cells_.size());
     const std::uint32_t cell = index_.insert(voxel_key(c.x(), c.y(), c.z()), id);
     if (cell == id) {
       cells_.push_back(Cell{c, 0});
       pool_.resize(pool_.size() + 3 * stride_);
+      if (views) views_.resize(views_.size() + stride_);
     }
     Cell& cl = cells_[cell];
     if (cl.count >= max_per_cell_) continue;
@@ -36,9 +55,11 @@ std::size_t VoxelMap::insert(const FeatureCloud& points_lidar,
     bool too_close = false;
     for (std::uint32_t i = 0; i < cl.count && !too_close; ++i) {
       const float dx = xyz[3 * i] - p.x(), dy = xyz[3 * i + 1] - p.y(), dz = xyz[3 * i + 2] - p.z();
-      too_close = dx * dx + dy * dy + dz * dz < min_spacing_sq_;
+      too_close = dx * dx + dy * dy + dz * dz < min_spacing_sq_ &&
+                  (!views || view_close(cell_views(cell)[i], view));
     }
     if (too_close) continue;
+    if (views) cell_views(cell)[cl.count] = view;
     xyz[3 * cl.count] = p.x();
     xyz[3 * cl.count + 1] = p.y();
     xyz[3 * cl.count + 2] = p.z();
@@ -49,7 +70,9 @@ std::size_t VoxelMap::insert(const FeatureCloud& points_lidar,
   return stored;
 }
 
-void VoxelMap::knn(const Eigen::Vector3f& q, int k, float radius_m, Neighbors& out) const {
+void VoxelMap::knn(const Eigen::Vector3f& q, int k, float radius_m, Neighbors& out,
+                   const View* view) const {
+  if (view && !stores_views()) view = nullptr;
   k = std::min(k, kMaxK);
   out.count = 0;
   if (k <= 0) return;
@@ -86,7 +109,9 @@ void VoxelMap::knn(const Eigen::Vector3f& q, int k, float radius_m, Neighbors& o
     if (cell == FlatKeyIndex::kNone) continue;
     const float* xyz = cell_xyz(cell);
     const std::uint32_t n = cells_[cell].count;
+    const View* views = view ? cell_views(cell) : nullptr;
     for (std::uint32_t i = 0; i < n; ++i, xyz += 3) {
+      if (views && !view_close(views[i], *view)) continue;
       const float dx = xyz[0] - qx, dy = xyz[1] - qy, dz = xyz[2] - qz;
       const float d = dx * dx + dy * dy + dz * dz;
       if (d >= bound) continue;
@@ -114,6 +139,7 @@ void VoxelMap::remove_far(const Eigen::Vector3d& center, double radius_m) {
     if (kept != i) {
       cells_[kept] = cells_[i];
       std::copy_n(cell_xyz(i), 3 * stride_, cell_xyz(kept));
+      if (stores_views()) std::copy_n(cell_views(i), stride_, cell_views(kept));
     }
     num_points_ += cells_[kept].count;
     ++kept;
@@ -121,6 +147,7 @@ void VoxelMap::remove_far(const Eigen::Vector3d& center, double radius_m) {
   if (kept == cells_.size()) return;
   cells_.resize(kept);
   pool_.resize(kept * 3 * stride_);
+  if (stores_views()) views_.resize(kept * stride_);
   index_.reset(kept + 1024);
   for (std::size_t i = 0; i < kept; ++i) {
     const auto& c = cells_[i].coords;
@@ -131,6 +158,7 @@ void VoxelMap::remove_far(const Eigen::Vector3d& center, double radius_m) {
 void VoxelMap::clear() {
   cells_.clear();
   pool_.clear();
+  views_.clear();
   index_.reset(1024);
   num_points_ = 0;
 }

@@ -157,6 +157,8 @@ TEST(BadInput, ConfigValuesOutOfRangeNameTheKey) {
        "odometry.registration.plane_min_spread_ratio"},
       {"odometry:\n  registration:\n    edge_max_residual_m: -0.1\n",
        "odometry.registration.edge_max_residual_m"},
+      {"odometry:\n  registration:\n    edge_view_tolerance_deg: 180\n",
+       "odometry.registration.edge_view_tolerance_deg"},
       {"odometry:\n  registration:\n    plane_max_dist_m: 0\n", "odometry.registration.plane_max_dist_m"},
       {"loop_registration:\n  check_plane_max_dist_m: -0.2\n",
        "loop_registration.check_plane_max_dist_m"},

@@ -148,6 +148,36 @@ TEST(ScanToMap, EdgeResidualCutRefusesAFarLineButKeepsANearOne) {
   EXPECT_EQ(edge_matches(far, 0.35), n);
 }
 
+TEST(ScanToMap, ViewFilterMatchesALineOnlyFromAboutTheDirectionItWasSeenFrom) {
+  // A vertical line of edge points at (5, 0), mapped once from the south (sensor at (5, -10):
+  // a trunk's silhouette seen from there) and once from the west (the origin). The scan's
+  // points on it are seen from the origin, looking east.
+  FeatureCloud line_from_south, line_from_west, queries;
+  for (int i = -10; i <= 10; ++i) {
+    const float z = 0.1f * static_cast<float>(i);
+    line_from_south.emplace_back(0.0f, 10.0f, z);  // in the southern sensor's frame
+    line_from_west.emplace_back(5.0f, 0.0f, z);
+    if (i > -5 && i < 5) queries.emplace_back(5.03f, 0.0f, z + 0.05f);
+  }
+  Eigen::Isometry3d south = Eigen::Isometry3d::Identity();
+  south.translation() = Eigen::Vector3d(5, -10, 0);
+  OdometryConfig c;
+  const auto edge_matches = [&](bool seen_from_west, double view_tolerance_deg) {
+    c.registration.edge_view_tolerance_deg = view_tolerance_deg;
+    FeatureMap map(c.registration, c.map);
+    if (seen_from_west) map.insert(line_from_west, {}, Eigen::Isometry3d::Identity());
+    else map.insert(line_from_south, {}, south);
+    ScanToMapRegistration registration(c.registration);
+    return registration.count_matches(queries, {}, map, Eigen::Isometry3d::Identity()).first;
+  };
+  const int n = static_cast<int>(queries.size());
+  EXPECT_EQ(edge_matches(false, 0.0), n);  // F-LOAM: any line within reach
+  EXPECT_EQ(edge_matches(false, 20.0), 0);  // seen from 90 deg away: another silhouette
+  EXPECT_EQ(edge_matches(false, 95.0), n);
+  EXPECT_EQ(edge_matches(true, 20.0), n);
+  EXPECT_EQ(edge_matches(true, 0.0), n);
+}
+
 TEST(ScanToMap, CountMatchesAtTheSolutionAreAlignsAndFollowTheFlatnessTest) {
   // A ground grid with a rough strip (every other row 0.25 m up): the strip's neighbourhoods
   // pass a 0.2 m flatness test and fail a 0.1 m one.

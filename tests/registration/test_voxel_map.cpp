@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <random>
 
 #include "scfloam/registration/voxel_filter.hpp"
@@ -62,6 +63,58 @@ TEST(VoxelMap, InsertAppliesThePose) {
   map.knn(Eigen::Vector3f(101, 2, 3), 1, 0.5f, nb);
   ASSERT_EQ(nb.count, 1);
   EXPECT_FLOAT_EQ(nb.sq_dist[0], 0.f);
+}
+
+TEST(VoxelMap, ViewsKeepPointsSeenFromElsewhereAndFilterQueries) {
+  // One pole point at (10, 0, 0), seen from the origin (view 0 deg) and from (10, -10, 0)
+  // (view 90 deg); tolerance 20 deg, spacing 0.5 m.
+  VoxelMap map(1.0, 0.5, 10, 20.0 * M_PI / 180.0);
+  ASSERT_TRUE(map.stores_views());
+  Eigen::Isometry3d from_origin = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d from_south = Eigen::Isometry3d::Identity();
+  from_south.translation() = Eigen::Vector3d(10, -10, 0);
+  EXPECT_EQ(map.insert({Eigen::Vector3f(10, 0, 0)}, from_origin), 1u);
+  // 10 cm away, seen from the same side: refused by the spacing; from the other view: kept.
+  EXPECT_EQ(map.insert({Eigen::Vector3f(10.1f, 0, 0)}, from_origin), 0u);
+  EXPECT_EQ(map.insert({Eigen::Vector3f(0.1f, 10, 0)}, from_south), 1u);  // world (10.1, 0, 0)
+  EXPECT_EQ(map.num_points(), 2u);
+
+  const Eigen::Vector3f q(10.05f, 0, 0);
+  VoxelMap::Neighbors nb;
+  map.knn(q, 5, 1.0f, nb);
+  EXPECT_EQ(nb.count, 2);  // no filter: both
+  const VoxelMap::View east = VoxelMap::view_of(Eigen::Vector3f(0, 0, 0), q);
+  map.knn(q, 5, 1.0f, nb, &east);
+  ASSERT_EQ(nb.count, 1);
+  EXPECT_FLOAT_EQ(nb.points[0].x(), 10.f);
+  const VoxelMap::View north = VoxelMap::view_of(Eigen::Vector3f(10, -10, 0), q);
+  map.knn(q, 5, 1.0f, nb, &north);
+  ASSERT_EQ(nb.count, 1);
+  EXPECT_NEAR(nb.points[0].x(), 10.1f, 1e-5f);
+  // 30 deg off either view: nothing.
+  const VoxelMap::View between = VoxelMap::view_of(Eigen::Vector3f(0, 0, 0),
+                                                   Eigen::Vector3f(std::cos(0.52f), std::sin(0.52f), 0));
+  map.knn(q, 5, 1.0f, nb, &between);
+  EXPECT_EQ(nb.count, 0);
+
+  // Views wrap at +-180 deg: seen heading -179 deg, a query at +179 deg is 2 deg off.
+  VoxelMap wrap(1.0, 0.5, 10, 5.0 * M_PI / 180.0);
+  const Eigen::Vector3f west(-10, -0.17f, 0), query(-10, 0.17f, 0);
+  wrap.insert({west}, Eigen::Isometry3d::Identity());
+  const VoxelMap::View v = VoxelMap::view_of(Eigen::Vector3f(0, 0, 0), query);
+  wrap.knn(query, 1, 1.0f, nb, &v);
+  EXPECT_EQ(nb.count, 1);
+
+  // remove_far moves the kept cells down over the dropped ones: views must move with them.
+  VoxelMap moved(1.0, 0.5, 10, 20.0 * M_PI / 180.0);
+  moved.insert({Eigen::Vector3f(-50, 0, 0)}, from_origin);  // the first cell, dropped below
+  moved.insert({Eigen::Vector3f(10, 0, 0)}, from_origin);
+  moved.insert({Eigen::Vector3f(0.1f, 10, 0)}, from_south);
+  moved.remove_far(Eigen::Vector3d(10, 0, 0), 5.0);
+  EXPECT_EQ(moved.num_points(), 2u);
+  moved.knn(q, 5, 1.0f, nb, &north);
+  ASSERT_EQ(nb.count, 1);
+  EXPECT_NEAR(nb.points[0].x(), 10.1f, 1e-5f);
 }
 
 TEST(VoxelFilter, OneCentroidPerVoxel) {
