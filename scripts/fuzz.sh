@@ -22,6 +22,11 @@ cd "$(dirname "$0")/.."
 shared="${SCFLOAM_SHARED_DIR:-$(cd .. && pwd)/shared}"
 build="${SCFLOAM_FUZZ_BUILD:-build-fuzz}"
 seed="${SCFLOAM_FUZZ_SEED:-}"
+# The harness writes each input to a file in the temporary folder: a folder of its own, removed
+# at exit, so that runs leave nothing in /tmp.
+TMPDIR="$(mktemp -d "${TMPDIR:-/tmp}/scfloam-fuzz.XXXXXX")"
+export TMPDIR
+trap 'rm -rf "$TMPDIR"' EXIT
 
 targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then

@@ -5,10 +5,13 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
+#include <cstdlib>
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
 namespace scfloam::test {
 
@@ -21,6 +24,37 @@ inline std::filesystem::path shared_dir() { return SCFLOAM_SHARED_DIR; }
   if (!std::filesystem::exists(var))                                                        \
   GTEST_SKIP() << "shared data not found at " << var                                        \
                << " (clone lacks ../shared; configure with -DSCFLOAM_SHARED_DIR=...)"
+
+// Every scratch folder a test process made is removed when the process ends (static
+// destruction after main), so the suite leaves nothing behind: simulated sequences are 0.3-1.1 GB
+// each and CI's disk is shared (a full disk failed CI once). SCFLOAM_KEEP_TEST_SCRATCH=1 keeps
+// them to look at. A crashed process leaves its folders; the next run of the test removes them.
+class ScratchFolders {
+ public:
+  static ScratchFolders& instance() {
+    static ScratchFolders folders;
+    return folders;
+  }
+  void add(const std::filesystem::path& dir) { dirs_.push_back(dir); }
+  // Removes one folder now (a test done with a large input) and forgets it.
+  void remove(const std::filesystem::path& dir) {
+    std::error_code ec;
+    if (!keep()) std::filesystem::remove_all(dir, ec);
+    dirs_.erase(std::remove(dirs_.begin(), dirs_.end(), dir), dirs_.end());
+  }
+  ~ScratchFolders() {
+    if (keep()) return;
+    std::error_code ec;
+    for (const auto& dir : dirs_) std::filesystem::remove_all(dir, ec);
+  }
+
+ private:
+  static bool keep() {
+    const char* v = std::getenv("SCFLOAM_KEEP_TEST_SCRATCH");
+    return v && std::string(v) == "1";
+  }
+  std::vector<std::filesystem::path> dirs_;
+};
 
 // A fresh scratch folder for one test, removed first if it exists. One per process: ctest runs
 // every test as its own process, two at a time, and a suite's shared setup (SetUpTestSuite)
@@ -40,6 +74,7 @@ inline std::filesystem::path scratch_dir(const std::string& name) {
   }
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
+  ScratchFolders::instance().add(dir);
   return dir;
 }
 

@@ -1,10 +1,9 @@
 // The whole system on the degenerate scenes of issue 8 (sim/degenerate.hpp): each run
 // completes in both modes with finite poses, the degenerate frames are counted in the result
 // (summary.json's degenerate_frames), and the error once structure returns is bounded.
-// Each scene is simulated once per build tree into test-scratch/ (KITTI layout, as a user's
-// input: no ring or point time survives the .bin files).
+// Each test simulates its scene into its own scratch folder (KITTI layout, as a user's input:
+// no ring or point time survives the .bin files), removed when the test process ends.
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <cstdint>
@@ -16,6 +15,7 @@
 #include "scfloam/se3.hpp"
 #include "scfloam/sim/simulate.hpp"
 #include "scfloam/stats.hpp"
+#include "test_paths.hpp"
 
 using namespace scfloam;
 namespace fs = std::filesystem;
@@ -29,21 +29,13 @@ struct Scene {
 
 Scene simulated(const std::string& name, std::size_t frames, bool traffic, std::uint64_t seed = 3) {
   Scene scene;
-  scene.dir = fs::path(SCFLOAM_BINARY_DIR) / "test-scratch" /
-              ("degenerate_" + name + "_" + std::to_string(frames) + (seed == 3 ? "" : "_seed" + std::to_string(seed)));
-  if (!fs::exists(scene.dir / "poses.txt")) {
-    const fs::path tmp = scene.dir.string() + ".tmp-" + std::to_string(::getpid());
-    fs::remove_all(tmp);
-    sim::SimConfig config;
-    config.seed = seed;
-    config.frames = frames;
-    config.scenario = name;
-    config.traffic.enabled = traffic;
-    sim::simulate_sequence(config, tmp, false);
-    std::error_code ec;
-    fs::rename(tmp, scene.dir, ec);  // another process may have won the race: use its copy
-    if (ec) fs::remove_all(tmp);
-  }
+  scene.dir = test::scratch_dir("degenerate_" + name + "_" + std::to_string(frames) + "_seed" + std::to_string(seed));
+  sim::SimConfig config;
+  config.seed = seed;
+  config.frames = frames;
+  config.scenario = name;
+  config.traffic.enabled = traffic;
+  sim::simulate_sequence(config, scene.dir, false);
   std::FILE* f = std::fopen((scene.dir / "sim.yaml").c_str(), "r");
   char line[512];
   while (f && std::fgets(line, sizeof line, f))
@@ -181,6 +173,7 @@ TEST(Degenerate, OpenFieldRecoversInTheNextVillage) {
     std::printf("open field, seed %d: worst step from 2 s into the second village %.3f m\n",
                 static_cast<int>(seed), after);
     EXPECT_LT(after, 0.05) << "seed " << seed;
+    test::ScratchFolders::instance().remove(scene.dir);  // 0.5 GB each: one on disk at a time
   }
 }
 

@@ -17,20 +17,17 @@ namespace fs = std::filesystem;
 namespace {
 
 // A 600-frame (~400 m) city drive with same- and opposite-direction revisits, simulated once
-// per build tree (tests run as separate processes; the folder appears complete or not at all).
+// per test process into its scratch folder (1.1 GB, removed when the process ends).
 fs::path loops_sequence() {
-  const fs::path dir = fs::path(SCFLOAM_BINARY_DIR) / "test-scratch" / "pipeline_loops_seed5_600";
-  if (fs::exists(dir / "poses.txt")) return dir;
-  const fs::path tmp = dir.string() + ".tmp-" + std::to_string(::getpid());
-  fs::remove_all(tmp);
-  sim::SimConfig config;
-  config.seed = 5;
-  config.frames = 600;
-  config.route = "loops";
-  sim::simulate_sequence(config, tmp, false);
-  std::error_code ec;
-  fs::rename(tmp, dir, ec);  // another process may have won the race: use its copy
-  if (ec) fs::remove_all(tmp);
+  static const fs::path dir = [] {
+    const fs::path out = test::scratch_dir("pipeline_loops_seed5_600");
+    sim::SimConfig config;
+    config.seed = 5;
+    config.frames = 600;
+    config.route = "loops";
+    sim::simulate_sequence(config, out, false);
+    return out;
+  }();
   return dir;
 }
 
