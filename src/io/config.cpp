@@ -36,6 +36,7 @@ std::vector<Binding> bindings(SlamConfig& c) {
       {pre, "elevation_correction_deg", &o.preprocess.elevation_correction_deg},
       {pre, "online_elevation_calibration", &o.preprocess.online_elevation_calibration},
       {pre, "elevation_calibration_gain", &o.preprocess.elevation_calibration_gain},
+      {pre, "ground_elevation_calibration", &o.preprocess.ground_elevation_calibration},
       {ring, "lidar", &o.rings.lidar},
       {ring, "use_ring_field", &o.rings.use_ring_field},
       {ring, "adopt_learned_layout", &o.rings.adopt_learned_layout},

@@ -9,6 +9,7 @@
 #include "scfloam/features/deskew.hpp"
 #include "scfloam/features/feature_extractor.hpp"
 #include "scfloam/odometry/elevation_calibration.hpp"
+#include "scfloam/odometry/ground_elevation.hpp"
 #include "scfloam/registration/scan_to_map.hpp"
 #include "scfloam/registration/voxel_filter.hpp"
 #include "scfloam/se3.hpp"
@@ -26,6 +27,8 @@ struct Odometry::Impl {
     if (c.preprocess.online_elevation_calibration)
       elevation.emplace(c.preprocess.elevation_correction_deg,
                         c.preprocess.elevation_calibration_gain, 1.0);
+    if (c.preprocess.ground_elevation_calibration)
+      ground_elevation.emplace(c.preprocess.elevation_correction_deg);
   }
 
   OdometryConfig config;
@@ -50,6 +53,7 @@ struct Odometry::Impl {
   double delta_dt_s = 0;
   Eigen::Vector3d last_cleanup_position = Eigen::Vector3d::Zero();
   std::optional<ElevationCalibration> elevation;  // when the config estimates the offset
+  std::optional<GroundElevationEstimate> ground_elevation;  // ... or takes it from the road's shape
 };
 
 namespace {
@@ -125,6 +129,9 @@ Odometry::Odometry(const OdometryConfig& config) : impl_(std::make_unique<Impl>(
     throw Error("odometry config: outer_iterations and inner_iterations must be >= 1");
   if (p.online_elevation_calibration && !(p.elevation_calibration_gain > 0 && p.elevation_calibration_gain <= 5))
     throw Error("odometry config: elevation_calibration_gain must be in (0, 5]");
+  if (p.online_elevation_calibration && p.ground_elevation_calibration)
+    throw Error("odometry config: online_elevation_calibration and ground_elevation_calibration both "
+                "estimate the elevation correction: choose one");
 }
 
 Odometry::~Odometry() = default;
@@ -152,8 +159,9 @@ OdometryResult Odometry::process(const Scan& scan) {
     s.early_points[s.frames] = scan.points;
     s.early_has_ring = scan.has_ring && c.rings.use_ring_field;
   }
-  result.elevation_correction_deg =
-      s.elevation ? s.elevation->correction_deg() : c.preprocess.elevation_correction_deg;
+  result.elevation_correction_deg = s.elevation          ? s.elevation->correction_deg()
+                                    : s.ground_elevation ? s.ground_elevation->correction_deg()
+                                                         : c.preprocess.elevation_correction_deg;
   s.extractor.extract(*points, scan.has_ring && c.rings.use_ring_field, s.raw_edges, s.raw_planes);
   s.edge_filter.filter(s.raw_edges, c.features.edge_leaf_m, result.edges);
   s.plane_filter.filter(s.raw_planes, c.features.plane_leaf_m, result.planes);
@@ -240,6 +248,10 @@ OdometryResult Odometry::process(const Scan& scan) {
           s.elevation->update(registration.plane_matches(), result.T_world_lidar));
     }
     s.T_delta = orthonormalized(s.T_last.inverse() * result.T_world_lidar);
+    // The road in this scan (raw points, before any correction) against a scan ~10 m back.
+    if (s.ground_elevation && !gap && !result.degenerate)
+      s.extractor.set_elevation_correction_deg(
+          s.ground_elevation->update(*points, result.T_world_lidar, s.T_delta.translation()));
     s.delta_dt_s = scan.timestamp_s - s.last_stamp_s;
   }
   // The first frame seeds the map with its full-density features: frame 1 starts from a

@@ -84,6 +84,22 @@ TEST(Config, OnlineElevationCalibrationGainIsChecked) {
   EXPECT_NO_THROW(Odometry{c});
 }
 
+TEST(Config, GroundElevationCalibrationLoadsAndExcludesThePlaneMatchEstimate) {
+  const auto dir = test::scratch_dir("config_ground_elevation");
+  write(dir / "g.yaml", "odometry:\n  preprocess:\n    ground_elevation_calibration: true\n");
+  OdometryConfig c = load_config(dir / "g.yaml").odometry;
+  EXPECT_TRUE(c.preprocess.ground_elevation_calibration);
+  EXPECT_FALSE(SlamConfig{}.odometry.preprocess.ground_elevation_calibration);
+  EXPECT_NO_THROW(Odometry{c});
+  c.preprocess.online_elevation_calibration = true;  // two estimates of one number
+  try {
+    Odometry{c};
+    ADD_FAILURE() << "both estimators accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("ground_elevation_calibration"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Config, ShippedPresetsLoadAndConstructTheOdometry) {
   // tests/odometry/this_file.cpp -> repository root.
   const std::filesystem::path config_dir =
@@ -102,6 +118,7 @@ TEST(Config, ShippedPresetsLoadAndConstructTheOdometry) {
     EXPECT_EQ(c.odometry.preprocess.deskew, !kitti);
     // The online offset estimate costs accuracy where the start is right (docs/odometry.md).
     EXPECT_FALSE(c.odometry.preprocess.online_elevation_calibration);
+    EXPECT_FALSE(c.odometry.preprocess.ground_elevation_calibration);
     ++n;
   }
   EXPECT_EQ(n, 7);
