@@ -145,8 +145,10 @@ struct SpotPair {
 struct RoadGrid {
   static constexpr double kCellM = 0.5;
   static std::int64_t cell_of(double v) { return static_cast<std::int64_t>(std::floor(v / kCellM)); }
-  static std::int64_t key(std::int64_t cx, std::int64_t cy) {
-    return (cx << 32) ^ static_cast<std::int64_t>(static_cast<std::uint32_t>(cy));
+  // Both cells' low 32 bits side by side (unsigned: shifting a negative value is undefined).
+  static std::uint64_t key(std::int64_t cx, std::int64_t cy) {
+    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(cx)) << 32) |
+           static_cast<std::uint32_t>(cy);
   }
   explicit RoadGrid(std::vector<Eigen::Vector3f> road) : points(std::move(road)) {
     cells.reserve(points.size() / 2);
@@ -154,7 +156,7 @@ struct RoadGrid {
       cells[key(cell_of(points[i].x()), cell_of(points[i].y()))].push_back(static_cast<std::uint32_t>(i));
   }
   std::vector<Eigen::Vector3f> points;
-  std::unordered_map<std::int64_t, std::vector<std::uint32_t>> cells;
+  std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> cells;
 };
 
 namespace {
