@@ -34,9 +34,9 @@ struct PreprocessConfig {
   // Estimates the correction online from the road: the heights of one spot of road seen from
   // two places 6-30 m apart (odometry/ground_elevation.hpp), pooled over the drive and used
   // from the 10th such pair, within 1 deg of elevation_correction_deg. For a vehicle on a road
-  // with a 32+ beam sensor (a VLP-16's rings are too sparse: it stays at the configured value);
-  // not with online_elevation_calibration. Off by default: the beams' own elevation errors bias
-  // it by up to ~0.04 deg (docs/odometry.md, "Session 25").
+  // with a 64/128-beam sensor (it harmed an HDL-32E; a VLP-16's rings are too sparse for pairs,
+  // so it stays at the configured value); not with online_elevation_calibration. Off by default: the beams' own elevation errors bias
+  // it by up to ~0.05 deg (docs/odometry.md, "Session 25").
   bool ground_elevation_calibration = false;
 };
 

@@ -248,7 +248,7 @@ OdometryResult Odometry::process(const Scan& scan) {
           s.elevation->update(registration.plane_matches(), result.T_world_lidar));
     }
     s.T_delta = orthonormalized(s.T_last.inverse() * result.T_world_lidar);
-    // The road in this scan (raw points, before any correction) against a scan ~10 m back.
+    // The road in this scan (raw points, before any correction) against a scan 6-30 m back.
     if (s.ground_elevation && !gap && !result.degenerate)
       s.extractor.set_elevation_correction_deg(
           s.ground_elevation->update(*points, result.T_world_lidar, s.T_delta.translation()));
