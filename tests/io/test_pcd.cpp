@@ -2,12 +2,15 @@
 // another library (Open3D), and truncated/corrupt files.
 #include <gtest/gtest.h>
 
+#include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <fstream>
 #include <open3d/geometry/PointCloud.h>
 #include <open3d/io/PointCloudIO.h>
 #include <random>
+#include <sys/stat.h>
+#include <thread>
 
 #include "scfloam/error.hpp"
 #include "scfloam/io/lzf.hpp"
@@ -93,6 +96,32 @@ TEST(Pcd, RoundTripOfEveryEncodingWithAndWithoutRingAndTime) {
         }
       }
     }
+  }
+}
+
+// A scan read through a pipe (no size to ask for) reads the same as from a file: the reader
+// takes the whole file in one read when it can and falls back to a stream when it cannot.
+TEST(Pcd, ReadsThroughAPipeAsFromAFile) {
+  const fs::path dir = test::scratch_dir("pcd_pipe");
+  const auto pts = sample_points(3000);
+  const fs::path file = dir / "scan.pcd", pipe = dir / "pipe.pcd";
+  write_pcd(file, pts, PcdEncoding::kBinary, true);
+  fs::remove(pipe);
+  ASSERT_EQ(mkfifo(pipe.c_str(), 0600), 0) << std::strerror(errno);
+  std::thread writer([&] {
+    std::ifstream in(file, std::ios::binary);
+    std::ofstream out(pipe, std::ios::binary);
+    out << in.rdbuf();
+  });
+  const PointCloudFile through_pipe = read_pcd(pipe);
+  writer.join();
+  const PointCloudFile direct = read_pcd(file);
+  ASSERT_EQ(through_pipe.scan.points.size(), pts.size());
+  ASSERT_EQ(direct.scan.points.size(), pts.size());
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    ASSERT_EQ(through_pipe.scan.points[i].x, pts[i].x) << i;
+    ASSERT_EQ(direct.scan.points[i].z, pts[i].z) << i;
+    ASSERT_EQ(through_pipe.scan.points[i].time_s, direct.scan.points[i].time_s) << i;
   }
 }
 
