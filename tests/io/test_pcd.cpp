@@ -147,6 +147,30 @@ TEST(Pcd, Float64CoordinateBeyondFloatRangeIsDropped) {
   EXPECT_FLOAT_EQ(f.scan.points[1].intensity, 0.f);
 }
 
+// A ring field stored as float may hold NaN or values beyond int16: the point keeps its
+// coordinates and gets "no ring" (-1) or the nearest representable ring, never an undefined cast.
+TEST(Pcd, FloatRingFieldWithNaNAndHugeValuesIsClamped) {
+  const fs::path path = test::scratch_dir("pcd_ring_nan") / "ring.pcd";
+  std::string s =
+      "VERSION 0.7\nFIELDS x y z ring\nSIZE 4 4 4 4\nTYPE F F F F\nWIDTH 3\nHEIGHT 1\n"
+      "POINTS 3\nDATA binary\n";
+  const float rings[] = {std::nanf(""), 1e9f, 5.f};
+  for (int i = 0; i < 3; ++i) {
+    append<float>(s, 1.f + i);
+    append<float>(s, 2.f);
+    append<float>(s, 3.f);
+    append<float>(s, rings[i]);
+  }
+  write_bytes(path, s);
+  const PointCloudFile f = read_pcd(path);
+  ASSERT_EQ(f.scan.points.size(), 3u);
+  EXPECT_TRUE(f.scan.has_ring);
+  EXPECT_EQ(f.scan.points[0].ring, -1);
+  EXPECT_EQ(f.scan.points[1].ring, 32767);
+  EXPECT_EQ(f.scan.points[2].ring, 5);
+  EXPECT_FLOAT_EQ(f.scan.points[0].x, 1.f);
+}
+
 TEST(Pcd, UnusualLayoutFieldOrderPaddingFloat64Uint8CountAndNaN) {
   const fs::path path = test::scratch_dir("pcd_layout") / "odd.pcd";
   // intensity (uint8) first, a 3-byte padding field `_`, z before x, x/y float64, a normal of
