@@ -22,6 +22,13 @@ struct LidarPoint {
 // infinities and finite doubles beyond float's range (which would become inf).
 inline bool fits_float(double v) { return std::abs(v) <= std::numeric_limits<float>::max(); }
 
+// A ring field's value as a LidarPoint ring: NaN is "no ring" (-1), values outside -1..32767
+// are clamped (a plain cast of them would be undefined behaviour).
+inline std::int16_t ring_from_value(double v) {
+  if (std::isnan(v)) return -1;
+  return static_cast<std::int16_t>(v < -1.0 ? -1.0 : v > 32767.0 ? 32767.0 : v);
+}
+
 struct Scan {
   double timestamp_s = 0;
   std::vector<LidarPoint> points;

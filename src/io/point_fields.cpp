@@ -193,10 +193,7 @@ void append_points(const unsigned char* data, std::size_t count, std::size_t str
       const double v = read_value(p + fi->offset, fi->type, swap);
       q.intensity = fits_float(v) ? static_cast<float>(v) : 0.f;
     }
-    if (fr) {
-      const double ring = read_value(p + fr->offset, fr->type, swap);  // NaN: no ring (a cast would be undefined)
-      q.ring = std::isnan(ring) ? -1 : static_cast<std::int16_t>(std::clamp(ring, -1.0, 32767.0));
-    }
+    if (fr) q.ring = ring_from_value(read_value(p + fr->offset, fr->type, swap));
     if (time_rule.valid) {
       const double t = read_value(p + ft->offset, ft->type, swap);
       q.time_s = static_cast<float>(t * time_rule.scale - time_rule.subtract_s);

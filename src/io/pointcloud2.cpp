@@ -203,8 +203,11 @@ Scan pointcloud2_to_scan(const PointCloud2View& cloud, const std::string& where)
       pt.x = static_cast<float>(x);
       pt.y = static_cast<float>(y);
       pt.z = static_cast<float>(z);
-      if (fi) pt.intensity = static_cast<float>(read_value(p + fi->offset, fi->datatype, swap));
-      if (fr) pt.ring = static_cast<std::int16_t>(read_value(p + fr->offset, fr->datatype, swap));
+      if (fi) {
+        const double v = read_value(p + fi->offset, fi->datatype, swap);
+        pt.intensity = fits_float(v) ? static_cast<float>(v) : 0.f;  // as the PCD/PLY readers do
+      }
+      if (fr) pt.ring = ring_from_value(read_value(p + fr->offset, fr->datatype, swap));
       if (time_rule.valid) {
         const double t = read_value(p + ft->offset, ft->datatype, swap);
         pt.time_s = static_cast<float>(t * time_rule.scale - time_rule.subtract_s);

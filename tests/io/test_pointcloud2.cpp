@@ -1,6 +1,10 @@
 // PointCloud2 -> Scan over unusual layouts, through the CDR encoder of the test writers.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstring>
+#include <limits>
+
 #include "scfloam/error.hpp"
 #include "scfloam/io/pointcloud2.hpp"
 #include "test_bag_writers.hpp"
@@ -155,6 +159,41 @@ TEST(PointCloud2, BadCloudsAreErrors) {
     } catch (const Error&) {
     }
   }
+}
+
+// Values a corrupt or unusual cloud may carry: a float ring field with NaN or beyond int16,
+// an infinite intensity. The points keep their coordinates; the ring becomes "no ring" (-1) or
+// the nearest valid value, the intensity 0 (as the PCD and PLY readers do), never an
+// undefined cast.
+TEST(PointCloud2, OutOfRangeRingAndIntensityValuesAreClampedNotCast) {
+  const auto pts = sample_points(4);
+  test::OwnedCloud c = test::make_cloud(pts, 0.0, {});
+  ASSERT_EQ(c.meta.fields[3].name, "intensity");
+  ASSERT_EQ(c.meta.fields[4].name, "ring");
+  // The float32 "intensity" slot read as the ring field; the uint16 ring slot ignored.
+  c.meta.fields[3].name = "ring";
+  c.meta.fields[4].name = "unused";
+  const float rings[] = {std::nanf(""), 1e9f, -5.f, 7.f};
+  for (std::size_t i = 0; i < 4; ++i)
+    std::memcpy(c.data.data() + i * c.meta.point_step + c.meta.fields[3].offset, &rings[i], 4);
+  auto bytes = test::encode_cdr(c, false);
+  Scan s = pointcloud2_to_scan(decode_cdr_pointcloud2(bytes.data(), bytes.size(), "w"), "w");
+  ASSERT_EQ(s.points.size(), 4u);
+  EXPECT_TRUE(s.has_ring);
+  EXPECT_EQ(s.points[0].ring, -1);
+  EXPECT_EQ(s.points[1].ring, 32767);
+  EXPECT_EQ(s.points[2].ring, -1);
+  EXPECT_EQ(s.points[3].ring, 7);
+  EXPECT_FLOAT_EQ(s.points[1].x, pts[1].x);
+  // An infinite intensity reads as 0.
+  c = test::make_cloud(pts, 0.0, {});
+  const float inf = std::numeric_limits<float>::infinity();
+  std::memcpy(c.data.data() + 2 * c.meta.point_step + c.meta.fields[3].offset, &inf, 4);
+  bytes = test::encode_cdr(c, false);
+  s = pointcloud2_to_scan(decode_cdr_pointcloud2(bytes.data(), bytes.size(), "w"), "w");
+  ASSERT_EQ(s.points.size(), 4u);
+  EXPECT_EQ(s.points[2].intensity, 0.f);
+  EXPECT_EQ(s.points[1].intensity, pts[1].intensity);
 }
 
 TEST(PointCloud2, DescribeFields) {
