@@ -1,6 +1,7 @@
 #include "scfloam/io/point_fields.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cmath>
 #include <cstring>
@@ -8,6 +9,7 @@
 #include <limits>
 
 #include "scfloam/error.hpp"
+#include "scfloam/io/field_names.hpp"
 
 namespace scfloam {
 namespace {
@@ -113,20 +115,20 @@ std::optional<FieldType> field_type_from_ply(const std::string& name) {
 
 PointLayout map_point_fields(const std::vector<CloudField>& fields) {
   // The first name of each list that is present wins (intensity before reflectivity, ...):
-  // the same names and preference as the PointCloud2 conversion of the bag readers.
-  auto find = [&](std::initializer_list<const char*> names) {
+  // the same lists as the PointCloud2 conversion of the bag readers (field_names.hpp).
+  auto find = [&](const auto& names) {
     for (const char* name : names)
       for (int i = 0; i < static_cast<int>(fields.size()); ++i)
         if (lower(fields[i].name) == name) return i;
     return -1;
   };
   PointLayout layout;
-  layout.x = find({"x"});
-  layout.y = find({"y"});
-  layout.z = find({"z"});
-  layout.intensity = find({"intensity", "reflectivity", "reflectance", "i"});
-  layout.ring = find({"ring", "channel"});
-  layout.time = find({"time", "t", "time_offset", "offset_time", "timestamp", "ts"});
+  layout.x = find(std::array{"x"});
+  layout.y = find(std::array{"y"});
+  layout.z = find(std::array{"z"});
+  layout.intensity = find(field_names::kIntensity);
+  layout.ring = find(field_names::kRing);
+  layout.time = find(field_names::kTime);
   if (layout.x < 0 || layout.y < 0 || layout.z < 0) {
     std::string names;
     for (const auto& f : fields) names += (names.empty() ? "" : " ") + f.name;

@@ -1,10 +1,12 @@
 #include "scfloam/io/pointcloud2.hpp"
 
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <limits>
 
 #include "scfloam/error.hpp"
+#include "scfloam/io/field_names.hpp"
 
 namespace scfloam {
 namespace {
@@ -47,20 +49,21 @@ double read_value(const std::uint8_t* p, std::uint8_t datatype, bool swap) {
   return std::numeric_limits<double>::quiet_NaN();
 }
 
-const PointField* find_field(const std::vector<PointField>& fields,
-                             std::initializer_list<const char*> names) {
+template <typename Names>
+const PointField* find_field(const std::vector<PointField>& fields, const Names& names) {
   for (const char* name : names)
     for (const PointField& f : fields)
       if (f.name == name) return &f;
   return nullptr;
 }
 
-const PointField* find_field(const PointCloud2View& cloud, std::initializer_list<const char*> names) {
+template <typename Names>
+const PointField* find_field(const PointCloud2View& cloud, const Names& names) {
   return find_field(cloud.fields, names);
 }
 
 const PointField* find_time_field(const std::vector<PointField>& fields) {
-  return find_field(fields, {"time", "t", "time_offset", "offset_time", "timestamp", "ts"});
+  return find_field(fields, field_names::kTime);
 }
 
 void check_field(const PointCloud2View& cloud, const PointField* f, const std::string& where) {
@@ -151,17 +154,17 @@ std::vector<std::string> describe_point_fields(const std::vector<PointField>& fi
 }
 
 Scan pointcloud2_to_scan(const PointCloud2View& cloud, const std::string& where) {
-  const PointField* fx = find_field(cloud, {"x"});
-  const PointField* fy = find_field(cloud, {"y"});
-  const PointField* fz = find_field(cloud, {"z"});
+  const PointField* fx = find_field(cloud, std::array{"x"});
+  const PointField* fy = find_field(cloud, std::array{"y"});
+  const PointField* fz = find_field(cloud, std::array{"z"});
   if (!fx || !fy || !fz) {
     std::string names;
     for (const PointField& f : cloud.fields) names += (names.empty() ? "" : " ") + f.name;
     throw Error(where + ": PointCloud2 has no x, y and z fields (fields: " +
                 (names.empty() ? std::string("none") : names) + ")");
   }
-  const PointField* fi = find_field(cloud, {"intensity", "reflectivity", "i"});
-  const PointField* fr = find_field(cloud, {"ring", "channel", "laser_id", "line"});
+  const PointField* fi = find_field(cloud, field_names::kIntensity);
+  const PointField* fr = find_field(cloud, field_names::kRing);
   const PointField* ft = find_time_field(cloud.fields);
   for (const PointField* f : {fx, fy, fz, fi, fr, ft}) check_field(cloud, f, where);
 

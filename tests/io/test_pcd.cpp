@@ -171,6 +171,28 @@ TEST(Pcd, FloatRingFieldWithNaNAndHugeValuesIsClamped) {
   EXPECT_FLOAT_EQ(f.scan.points[0].x, 1.f);
 }
 
+// The field names are the bag readers' (field_names.hpp): a VeloView export's `laser_id` is the
+// ring, `reflectance` the intensity, whatever the case.
+TEST(Pcd, FieldNamesAreTheBagReadersOnes) {
+  const fs::path path = test::scratch_dir("pcd_names") / "names.pcd";
+  std::string s =
+      "VERSION 0.7\nFIELDS X Y Z Reflectance laser_id\nSIZE 4 4 4 4 2\nTYPE F F F F U\nWIDTH 2\nHEIGHT 1\n"
+      "POINTS 2\nDATA binary\n";
+  for (int i = 0; i < 2; ++i) {
+    append<float>(s, 1.f + i);
+    append<float>(s, 2.f);
+    append<float>(s, 3.f);
+    append<float>(s, 0.25f * (i + 1));
+    append<std::uint16_t>(s, static_cast<std::uint16_t>(30 + i));
+  }
+  write_bytes(path, s);
+  const PointCloudFile f = read_pcd(path);
+  ASSERT_EQ(f.scan.points.size(), 2u);
+  EXPECT_TRUE(f.scan.has_ring);
+  EXPECT_EQ(f.scan.points[1].ring, 31);
+  EXPECT_FLOAT_EQ(f.scan.points[1].intensity, 0.5f);
+}
+
 TEST(Pcd, UnusualLayoutFieldOrderPaddingFloat64Uint8CountAndNaN) {
   const fs::path path = test::scratch_dir("pcd_layout") / "odd.pcd";
   // intensity (uint8) first, a 3-byte padding field `_`, z before x, x/y float64, a normal of

@@ -196,6 +196,18 @@ TEST(PointCloud2, OutOfRangeRingAndIntensityValuesAreClampedNotCast) {
   EXPECT_EQ(s.points[1].intensity, pts[1].intensity);
 }
 
+// The same field names as the PCD and PLY readers (field_names.hpp): `reflectance` is the intensity.
+TEST(PointCloud2, ReflectanceIsTheIntensityAsInPcd) {
+  const auto pts = sample_points(5);
+  test::OwnedCloud c = test::make_cloud(pts, 0.0, {});
+  ASSERT_EQ(c.meta.fields[3].name, "intensity");
+  c.meta.fields[3].name = "reflectance";
+  const auto bytes = test::encode_cdr(c, false);
+  const Scan s = pointcloud2_to_scan(decode_cdr_pointcloud2(bytes.data(), bytes.size(), "w"), "w");
+  ASSERT_EQ(s.points.size(), 5u);
+  for (std::size_t i = 0; i < 5; ++i) EXPECT_EQ(s.points[i].intensity, pts[i].intensity) << i;
+}
+
 TEST(PointCloud2, DescribeFields) {
   const test::OwnedCloud c = test::make_cloud(sample_points(3), 0.0, {});
   const auto f = describe_point_fields(c.meta.fields);
