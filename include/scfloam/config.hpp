@@ -35,8 +35,9 @@ struct PreprocessConfig {
   // two places 6-30 m apart (odometry/ground_elevation.hpp), pooled over the drive and used
   // from the 10th such pair, within 1 deg of elevation_correction_deg. For a vehicle on a road
   // with a 64/128-beam sensor (it harmed an HDL-32E; a VLP-16's rings are too sparse for pairs,
-  // so it stays at the configured value); not with online_elevation_calibration. Off by default: the beams' own elevation errors bias
-  // it by up to ~0.05 deg (docs/odometry.md, "Session 25").
+  // so it stays at the configured value); not with online_elevation_calibration. Off by
+  // default: the beams' own elevation errors and range biases bias it by up to ~0.05 deg
+  // (docs/odometry.md, "Session 25" and "Session 26").
   bool ground_elevation_calibration = false;
 };
 

@@ -42,6 +42,14 @@ void write_bytes(const fs::path& path, const std::string& bytes) {
   out << bytes;
 }
 
+// The header of an unorganized binary PCD of `points` points; the points' bytes follow.
+std::string binary_header(const std::string& fields, const std::string& sizes, const std::string& types,
+                          int points) {
+  const std::string n = std::to_string(points);
+  return "VERSION 0.7\nFIELDS " + fields + "\nSIZE " + sizes + "\nTYPE " + types + "\nWIDTH " + n +
+         "\nHEIGHT 1\nPOINTS " + n + "\nDATA binary\n";
+}
+
 template <typename T>
 void append(std::string& s, T v) {
   s.append(reinterpret_cast<const char*>(&v), sizeof v);
@@ -129,9 +137,7 @@ TEST(Pcd, ReadsThroughAPipeAsFromAFile) {
 // the point is dropped like a NaN, not stored as inf.
 TEST(Pcd, Float64CoordinateBeyondFloatRangeIsDropped) {
   const fs::path path = test::scratch_dir("pcd_huge") / "huge.pcd";
-  std::string s =
-      "VERSION 0.7\nFIELDS x y z intensity\nSIZE 8 4 4 8\nTYPE F F F F\nWIDTH 3\nHEIGHT 1\n"
-      "POINTS 3\nDATA binary\n";
+  std::string s = binary_header("x y z intensity", "8 4 4 8", "F F F F", 3);
   for (int i = 0; i < 3; ++i) {
     append<double>(s, i == 1 ? 1e300 : 1.0 + i);
     append<float>(s, 2.f);
@@ -151,9 +157,7 @@ TEST(Pcd, Float64CoordinateBeyondFloatRangeIsDropped) {
 // coordinates and gets "no ring" (-1) or the nearest representable ring, never an undefined cast.
 TEST(Pcd, FloatRingFieldWithNaNAndHugeValuesIsClamped) {
   const fs::path path = test::scratch_dir("pcd_ring_nan") / "ring.pcd";
-  std::string s =
-      "VERSION 0.7\nFIELDS x y z ring\nSIZE 4 4 4 4\nTYPE F F F F\nWIDTH 3\nHEIGHT 1\n"
-      "POINTS 3\nDATA binary\n";
+  std::string s = binary_header("x y z ring", "4 4 4 4", "F F F F", 3);
   const float rings[] = {std::nanf(""), 1e9f, 5.f};
   for (int i = 0; i < 3; ++i) {
     append<float>(s, 1.f + i);
@@ -175,9 +179,7 @@ TEST(Pcd, FloatRingFieldWithNaNAndHugeValuesIsClamped) {
 // ring, `reflectance` the intensity, whatever the case.
 TEST(Pcd, FieldNamesAreTheBagReadersOnes) {
   const fs::path path = test::scratch_dir("pcd_names") / "names.pcd";
-  std::string s =
-      "VERSION 0.7\nFIELDS X Y Z Reflectance laser_id\nSIZE 4 4 4 4 2\nTYPE F F F F U\nWIDTH 2\nHEIGHT 1\n"
-      "POINTS 2\nDATA binary\n";
+  std::string s = binary_header("X Y Z Reflectance laser_id", "4 4 4 4 2", "F F F F U", 2);
   for (int i = 0; i < 2; ++i) {
     append<float>(s, 1.f + i);
     append<float>(s, 2.f);
