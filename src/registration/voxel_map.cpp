@@ -12,10 +12,11 @@ VoxelMap::VoxelMap(double max_query_radius_m, double min_spacing_m, int max_poin
       inv_cell_size_(static_cast<float>(1.0 / max_query_radius_m)),
       min_spacing_sq_(static_cast<float>(min_spacing_m * min_spacing_m)),
       max_per_cell_(static_cast<std::uint32_t>(max_points_per_cell)),
-      stride_(static_cast<std::uint32_t>(std::max(max_points_per_cell, 1))) {
+      stride_(static_cast<std::uint32_t>(std::max(max_points_per_cell, 1))),
+      lines_per_cell_((1 + 3 * std::size_t{stride_} + 15) / 16) {
   if (!(max_query_radius_m > 0)) throw Error("voxel map: query radius must be positive");
   if (max_points_per_cell < 1) throw Error("voxel map: max_points_per_cell must be >= 1");
-  index_.reset(1024);
+  brick_index_.reset(64);
 }
 
 VoxelMap::VoxelMap(double max_query_radius_m, double min_spacing_m, int max_points_per_cell,
@@ -32,38 +33,59 @@ VoxelMap::View VoxelMap::view_of(const Eigen::Vector3f& sensor, const Eigen::Vec
   return static_cast<View>(static_cast<std::int32_t>(std::lround(az * (65536.0 / (2 * M_PI)))) & 0xffff);
 }
 
+std::uint32_t VoxelMap::index_cell(const Eigen::Vector3i& c, std::uint32_t cell) {
+  const auto fresh = static_cast<std::uint32_t>(bricks_.size() / kBrickCells);
+  const std::uint32_t brick = brick_index_.insert(brick_key(c), fresh);
+  if (brick == fresh) bricks_.resize(bricks_.size() + kBrickCells, FlatKeyIndex::kNone);
+  bricks_[std::size_t{brick} * kBrickCells + index_in_brick(c)] = cell;
+  return brick;
+}
+
+std::uint32_t VoxelMap::cell_at(const Eigen::Vector3i& c, BrickCursor& cursor) {
+  const std::uint64_t key = brick_key(c);
+  if (key != cursor.key) {
+    cursor.key = key;
+    cursor.brick = brick_index_.find(key);
+  }
+  if (cursor.brick != FlatKeyIndex::kNone) {
+    const std::uint32_t cell = bricks_[std::size_t{cursor.brick} * kBrickCells + index_in_brick(c)];
+    if (cell != FlatKeyIndex::kNone) return cell;
+  }
+  const auto cell = static_cast<std::uint32_t>(cells_.size());
+  cursor.brick = index_cell(c, cell);
+  cells_.push_back(c);
+  lines_.resize(lines_.size() + lines_per_cell_);
+  set_cell_count(cell, 0);
+  if (stores_views()) views_.resize(views_.size() + stride_);
+  return cell;
+}
+
 std::size_t VoxelMap::insert(const FeatureCloud& points_lidar,
                              const Eigen::Isometry3d& T_world_lidar) {
   const Eigen::Isometry3f T = T_world_lidar.cast<float>();
   const Eigen::Vector3f sensor = T.translation();
   const bool views = stores_views();
   std::size_t stored = 0;
+  BrickCursor cursor;
   for (const auto& pl : points_lidar) {
     const Eigen::Vector3f p = T * pl;
     const View view = views ? view_of(sensor, p) : View{0};
-    const Eigen::Vector3i c = voxel_coords(p, inv_cell_size_);
-    const auto id = static_cast<std::uint32_t>(cells_.size());
-    const std::uint32_t cell = index_.insert(voxel_key(c.x(), c.y(), c.z()), id);
-    if (cell == id) {
-      cells_.push_back(Cell{c, 0});
-      pool_.resize(pool_.size() + 3 * stride_);
-      if (views) views_.resize(views_.size() + stride_);
-    }
-    Cell& cl = cells_[cell];
-    if (cl.count >= max_per_cell_) continue;
+    const std::uint32_t cell = cell_at(voxel_coords(p, inv_cell_size_), cursor);
+    const std::uint32_t count = cell_count(cell);
+    if (count >= max_per_cell_) continue;
     float* xyz = cell_xyz(cell);
     bool too_close = false;
-    for (std::uint32_t i = 0; i < cl.count && !too_close; ++i) {
+    for (std::uint32_t i = 0; i < count && !too_close; ++i) {
       const float dx = xyz[3 * i] - p.x(), dy = xyz[3 * i + 1] - p.y(), dz = xyz[3 * i + 2] - p.z();
       too_close = dx * dx + dy * dy + dz * dz < min_spacing_sq_ &&
                   (!views || view_close(cell_views(cell)[i], view));
     }
     if (too_close) continue;
-    if (views) cell_views(cell)[cl.count] = view;
-    xyz[3 * cl.count] = p.x();
-    xyz[3 * cl.count + 1] = p.y();
-    xyz[3 * cl.count + 2] = p.z();
-    ++cl.count;
+    if (views) cell_views(cell)[count] = view;
+    xyz[3 * count] = p.x();
+    xyz[3 * count + 1] = p.y();
+    xyz[3 * count + 2] = p.z();
+    set_cell_count(cell, count + 1);
     ++num_points_;
     ++stored;
   }
@@ -102,13 +124,26 @@ void VoxelMap::knn(const Eigen::Vector3f& q, int k, float radius_m, Neighbors& o
   // the sorted best k.
   const float qx = q.x(), qy = q.y(), qz = q.z();
   float bound = r2;
+  const Eigen::Vector3i low((c.x() - 1) >> kBrickShift, (c.y() - 1) >> kBrickShift,
+                            (c.z() - 1) >> kBrickShift);
+  const std::uint32_t* bricks[8];
+  bool brick_known[8] = {false, false, false, false, false, false, false, false};
   for (const auto& o : kOrder) {
     const float box2 = face2[0][o[0] + 1] + face2[1][o[1] + 1] + face2[2][o[2] + 1];
     if (box2 >= bound) continue;
-    const std::uint32_t cell = index_.find(voxel_key(c.x() + o[0], c.y() + o[1], c.z() + o[2]));
+    const Eigen::Vector3i cn(c.x() + o[0], c.y() + o[1], c.z() + o[2]);
+    // The 3x3x3 block spans at most two bricks per axis: slot (bx, by, bz) - low brick.
+    const int slot = (((cn.x() >> kBrickShift) - low.x()) << 2) |
+                     (((cn.y() >> kBrickShift) - low.y()) << 1) | ((cn.z() >> kBrickShift) - low.z());
+    if (!brick_known[slot]) {
+      brick_known[slot] = true;
+      bricks[slot] = find_brick(brick_key(cn));
+    }
+    if (!bricks[slot]) continue;
+    const std::uint32_t cell = bricks[slot][index_in_brick(cn)];
     if (cell == FlatKeyIndex::kNone) continue;
     const float* xyz = cell_xyz(cell);
-    const std::uint32_t n = cells_[cell].count;
+    const std::uint32_t n = cell_count(cell);
     const View* views = view ? cell_views(cell) : nullptr;
     for (std::uint32_t i = 0; i < n; ++i, xyz += 3) {
       if (views && !view_close(views[i], *view)) continue;
@@ -134,32 +169,35 @@ void VoxelMap::remove_far(const Eigen::Vector3d& center, double radius_m) {
   std::size_t kept = 0;
   num_points_ = 0;
   for (std::size_t i = 0; i < cells_.size(); ++i) {
-    const Eigen::Vector3f mid = (cells_[i].coords.cast<float>().array() + 0.5f) * cell_size_;
+    const Eigen::Vector3f mid = (cells_[i].cast<float>().array() + 0.5f) * cell_size_;
     if ((mid - cf).squaredNorm() > r2) continue;
     if (kept != i) {
       cells_[kept] = cells_[i];
-      std::copy_n(cell_xyz(i), 3 * stride_, cell_xyz(kept));
+      std::copy_n(&lines_[i * lines_per_cell_], lines_per_cell_, &lines_[kept * lines_per_cell_]);
       if (stores_views()) std::copy_n(cell_views(i), stride_, cell_views(kept));
     }
-    num_points_ += cells_[kept].count;
+    num_points_ += cell_count(kept);
     ++kept;
   }
   if (kept == cells_.size()) return;
   cells_.resize(kept);
-  pool_.resize(kept * 3 * stride_);
+  lines_.resize(kept * lines_per_cell_);
   if (stores_views()) views_.resize(kept * stride_);
-  index_.reset(kept + 1024);
-  for (std::size_t i = 0; i < kept; ++i) {
-    const auto& c = cells_[i].coords;
-    index_.insert(voxel_key(c.x(), c.y(), c.z()), static_cast<std::uint32_t>(i));
-  }
+  rebuild_bricks();
+}
+
+void VoxelMap::rebuild_bricks() {
+  bricks_.clear();
+  brick_index_.reset(cells_.size() / 16 + 64);
+  for (std::size_t i = 0; i < cells_.size(); ++i)
+    index_cell(cells_[i], static_cast<std::uint32_t>(i));
 }
 
 void VoxelMap::clear() {
   cells_.clear();
-  pool_.clear();
+  lines_.clear();
   views_.clear();
-  index_.reset(1024);
+  rebuild_bricks();
   num_points_ = 0;
 }
 
@@ -168,7 +206,7 @@ FeatureCloud VoxelMap::points() const {
   out.reserve(num_points_);
   for (std::size_t i = 0; i < cells_.size(); ++i) {
     const float* xyz = cell_xyz(i);
-    for (std::uint32_t j = 0; j < cells_[i].count; ++j)
+    for (std::uint32_t j = 0, n = cell_count(i); j < n; ++j)
       out.emplace_back(xyz[3 * j], xyz[3 * j + 1], xyz[3 * j + 2]);
   }
   return out;

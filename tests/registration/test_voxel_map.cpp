@@ -36,6 +36,56 @@ TEST(VoxelMap, KnnMatchesBruteForce) {
   }
 }
 
+// Brute-force k nearest squared distances within radius r among `cloud`.
+std::vector<float> brute_knn(const FeatureCloud& cloud, const Eigen::Vector3f& q, int k, float r) {
+  std::vector<float> d2;
+  for (const auto& p : cloud)
+    if ((p - q).squaredNorm() < r * r) d2.push_back((p - q).squaredNorm());
+  std::sort(d2.begin(), d2.end());
+  if (d2.size() > static_cast<std::size_t>(k)) d2.resize(k);
+  return d2;
+}
+
+TEST(VoxelMap, KnnStaysExactAcrossBricksAfterRemoveFarAndClear) {
+  // Cells of 0.7 m grouped 8 x 8 x 8 into bricks: a cloud 40 m across, centred off the origin,
+  // spans many bricks on both sides of zero; dropping far cells renumbers the rest and
+  // rebuilds the bricks, clearing empties them. Every query must still see exactly the points
+  // brute force sees.
+  const float cell = 0.7f;
+  VoxelMap map(cell, 0.0, 1000);
+  FeatureCloud cloud = random_cloud(30000, 20.f, 3);
+  for (auto& p : cloud) p += Eigen::Vector3f(3.3f, -1.7f, 0.4f);
+  ASSERT_EQ(map.insert(cloud, Eigen::Isometry3d::Identity()), cloud.size());
+  auto check = [&](const FeatureCloud& stored, unsigned seed) {
+    FeatureCloud queries = random_cloud(400, 21.f, seed);
+    for (auto& q : queries) q += Eigen::Vector3f(3.3f, -1.7f, 0.4f);
+    VoxelMap::Neighbors nb;
+    for (const auto& q : queries) {
+      map.knn(q, 8, cell, nb);
+      const std::vector<float> want = brute_knn(stored, q, 8, cell);
+      ASSERT_EQ(nb.count, static_cast<int>(want.size()));
+      for (int i = 0; i < nb.count; ++i) EXPECT_FLOAT_EQ(nb.sq_dist[i], want[i]);
+    }
+  };
+  check(cloud, 4);
+
+  const Eigen::Vector3d center(-6.0, 5.0, 0.0);
+  map.remove_far(center, 12.0);
+  const FeatureCloud kept = map.points();
+  EXPECT_LT(kept.size(), cloud.size());
+  EXPECT_GT(kept.size(), cloud.size() / 20);
+  EXPECT_EQ(map.num_points(), kept.size());
+  check(kept, 5);
+
+  map.clear();
+  EXPECT_EQ(map.num_points(), 0u);
+  VoxelMap::Neighbors nb;
+  map.knn(cloud[0], 8, cell, nb);
+  EXPECT_EQ(nb.count, 0);
+  ASSERT_EQ(map.insert(cloud, Eigen::Isometry3d::Identity()), cloud.size());
+  check(cloud, 6);
+}
+
 TEST(VoxelMap, SpacingBoundsDensityAndRemoveFarDropsCells) {
   VoxelMap map(1.0, 0.5, 20);
   FeatureCloud line;

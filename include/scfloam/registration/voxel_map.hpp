@@ -1,4 +1,5 @@
-// Incremental local map of feature points: hash cells with a bounded number of points each.
+// Incremental local map of feature points: cells with a bounded number of points each, found
+// through a hash of 8x8x8-cell bricks.
 // Replaces F-LOAM's "crop the map and rebuild a k-d tree every frame": inserting a frame and
 // dropping far cells cost O(points touched), and a k-nearest query reads the few cells of the
 // 27 around it that can still hold a closer point.
@@ -6,8 +7,9 @@
 
 #include <Eigen/Geometry>
 #include <array>
-#include <cstdlib>
 #include <cstdint>
+#include <cstdlib>
+#include <cstring>
 #include <vector>
 
 #include "scfloam/config.hpp"
@@ -62,16 +64,49 @@ class VoxelMap {
   FeatureCloud points() const;
 
  private:
-  struct Cell {
-    Eigen::Vector3i coords;
-    std::uint32_t count = 0;
+  // Cells are found through bricks of 8x8x8 cells: a hash table maps a brick's coordinates to
+  // a dense block of its 512 cell numbers (kNone where empty). The up to 27 cells a query
+  // visits mostly lie in one or two bricks, whose entries for neighbouring cells share cache
+  // lines, where a hash of every cell scattered them over the table: the search waits on
+  // memory, not arithmetic (docs/odometry.md, "Session 27").
+  static constexpr int kBrickShift = 3;
+  static constexpr int kBrickCells = 1 << (3 * kBrickShift);
+  static std::uint64_t brick_key(const Eigen::Vector3i& c) {
+    return voxel_key(c.x() >> kBrickShift, c.y() >> kBrickShift, c.z() >> kBrickShift);
+  }
+  static int index_in_brick(const Eigen::Vector3i& c) {
+    constexpr int m = (1 << kBrickShift) - 1;
+    return ((c.x() & m) << (2 * kBrickShift)) | ((c.y() & m) << kBrickShift) | (c.z() & m);
+  }
+  const std::uint32_t* find_brick(std::uint64_t key) const {
+    const std::uint32_t b = brick_index_.find(key);
+    return b == FlatKeyIndex::kNone ? nullptr : &bricks_[std::size_t{b} * kBrickCells];
+  }
+  // The cell at c, created (empty) if it does not exist yet. `cursor` remembers the last
+  // brick: consecutive points of a scan mostly fall into the same one.
+  struct BrickCursor {
+    std::uint64_t key = ~std::uint64_t{0};  // no brick has this key
+    std::uint32_t brick = FlatKeyIndex::kNone;
   };
+  std::uint32_t cell_at(const Eigen::Vector3i& c, BrickCursor& cursor);
+  std::uint32_t index_cell(const Eigen::Vector3i& c, std::uint32_t cell);  // returns the brick
+  void rebuild_bricks();  // after cells were dropped or moved
 
-  // Cell c's points live at pool_[c * 3 * stride_], x y z after each other. Interleaved, not a
-  // structure of arrays: a query reads ~5 cells of ~5 points each, and the search waits on
-  // memory, so one or two cache lines per cell beat three (measured, docs/odometry.md).
-  float* cell_xyz(std::size_t cell) { return &pool_[cell * 3 * stride_]; }
-  const float* cell_xyz(std::size_t cell) const { return &pool_[cell * 3 * stride_]; }
+  // Cell c's block starts at a cache line: its point count, then x y z of each point. The count
+  // sits with the first points, so a query's first read of a cell is one line, not two.
+  struct alignas(64) Line {
+    float f[16];
+  };
+  float* cell_xyz(std::size_t cell) { return lines_[cell * lines_per_cell_].f + 1; }
+  const float* cell_xyz(std::size_t cell) const { return lines_[cell * lines_per_cell_].f + 1; }
+  std::uint32_t cell_count(std::size_t cell) const {
+    std::uint32_t n;
+    std::memcpy(&n, lines_[cell * lines_per_cell_].f, sizeof n);
+    return n;
+  }
+  void set_cell_count(std::size_t cell, std::uint32_t n) {
+    std::memcpy(lines_[cell * lines_per_cell_].f, &n, sizeof n);
+  }
 
   View* cell_views(std::size_t cell) { return &views_[cell * stride_]; }
   const View* cell_views(std::size_t cell) const { return &views_[cell * stride_]; }
@@ -83,11 +118,13 @@ class VoxelMap {
   float cell_size_, inv_cell_size_, min_spacing_sq_;
   View view_tolerance_ = 0;  // 0 = views not stored
   std::uint32_t max_per_cell_;
-  std::uint32_t stride_;  // points a cell has room for (max_per_cell_)
-  FlatKeyIndex index_;
-  std::vector<Cell> cells_;
-  std::vector<float> pool_;  // 3 * stride_ floats per cell
-  std::vector<View> views_;  // stride_ per cell when views are stored, else empty
+  std::uint32_t stride_;          // points a cell has room for (max_per_cell_)
+  std::size_t lines_per_cell_;    // cache lines of a cell's block
+  FlatKeyIndex brick_index_;
+  std::vector<std::uint32_t> bricks_;  // kBrickCells cell numbers per brick
+  std::vector<Eigen::Vector3i> cells_;  // each cell's coordinates
+  std::vector<Line> lines_;             // lines_per_cell_ per cell
+  std::vector<View> views_;             // stride_ per cell when views are stored, else empty
   std::size_t num_points_ = 0;
 };
 
