@@ -141,7 +141,6 @@ bool is_integer(FieldType type) { return type != FieldType::kFloat32 && type != 
 
 TimeRule choose_time_rule(const unsigned char* data, std::size_t count, std::size_t stride, const CloudField& field,
                           bool big_endian, double stamp_s) {
-  constexpr double kMaxScanSpanS = 1.5;  // slower than any spinning LiDAR's sweep
   const bool swap = big_endian != host_is_big_endian();
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
   for (std::size_t i = 0; i < count; ++i) {
@@ -150,8 +149,13 @@ TimeRule choose_time_rule(const unsigned char* data, std::size_t count, std::siz
     lo = std::min(lo, t);
     hi = std::max(hi, t);
   }
-  if (lo > hi) return {};
-  const bool floating = !is_integer(field.type);
+  return time_rule_for_range(lo, hi, is_integer(field.type), stamp_s);
+}
+
+TimeRule time_rule_for_range(double lo, double hi, bool integer_field, double stamp_s) {
+  constexpr double kMaxScanSpanS = 1.5;  // slower than any spinning LiDAR's sweep
+  if (!(lo <= hi)) return {};
+  const bool floating = !integer_field;
   // Without a stamp (PCD, PLY) the earliest point stands for it in the absolute readings.
   const double stamp_abs_s = stamp_s != 0 ? stamp_s : lo;
   const double stamp_abs_ns_s = stamp_s != 0 ? stamp_s : lo * 1e-9;

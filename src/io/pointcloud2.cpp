@@ -7,6 +7,7 @@
 
 #include "scfloam/error.hpp"
 #include "scfloam/io/field_names.hpp"
+#include "scfloam/io/point_fields.hpp"
 
 namespace scfloam {
 namespace {
@@ -83,19 +84,10 @@ bool is_integer_type(std::uint8_t datatype) {
 }
 
 
-// How per-point times become seconds relative to the stamp: t * scale - subtract_s.
-struct TimeRule {
-  bool valid = false;
-  double scale = 1, subtract_s = 0;
-};
-
-// Drivers disagree on the time field: Velodyne `time` is float seconds relative to the stamp,
-// Ouster `t` / Livox `offset_time` uint32 relative nanoseconds, Hesai / RoboSense `timestamp`
-// float64 absolute seconds, livox_ros_driver2 `timestamp` float64 absolute nanoseconds. The
-// first reading in this order that puts every point of the cloud within kMaxScanSpan of the
-// stamp wins (integers are only read as relative nanoseconds); none -> no per-point time.
-TimeRule choose_time_rule(const PointCloud2View& cloud, const PointField& ft, bool swap) {
-  constexpr double kMaxScanSpan = 1.5;  // seconds: slower than any spinning LiDAR's sweep
+// The time field's reading (float relative seconds, absolute seconds or nanoseconds, integer
+// relative nanoseconds) is point_fields' rule, shared with PCD and PLY; this only walks the
+// padded rows for the field's range.
+TimeRule pointcloud2_time_rule(const PointCloud2View& cloud, const PointField& ft, bool swap) {
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
   // width 0: no rows to walk (a fuzzed cloud of 0 x 4e9 points hung here).
   for (std::size_t r = 0; r < cloud.height && cloud.width > 0; ++r)
@@ -106,17 +98,7 @@ TimeRule choose_time_rule(const PointCloud2View& cloud, const PointField& ft, bo
       lo = std::min(lo, t);
       hi = std::max(hi, t);
     }
-  if (lo > hi) return {};
-  const double stamp = cloud.stamp_s();
-  const bool integer = is_integer_type(ft.datatype);
-  const TimeRule candidates[] = {{!integer, 1, 0}, {!integer, 1, stamp}, {!integer, 1e-9, stamp},
-                                 {true, 1e-9, 0}};
-  for (const TimeRule& rule : candidates) {
-    if (!rule.valid) continue;
-    const double a = lo * rule.scale - rule.subtract_s, b = hi * rule.scale - rule.subtract_s;
-    if (std::fabs(a) <= kMaxScanSpan && std::fabs(b) <= kMaxScanSpan) return rule;
-  }
-  return {};
+  return time_rule_for_range(lo, hi, is_integer_type(ft.datatype), cloud.stamp_s());
 }
 
 }  // namespace
@@ -190,8 +172,9 @@ Scan pointcloud2_to_scan(const PointCloud2View& cloud, const std::string& where)
   scan.points.reserve(width * height);
   const bool swap = cloud.is_bigendian == host_is_little_endian();
 
-  const TimeRule time_rule = ft ? choose_time_rule(cloud, *ft, swap) : TimeRule{};
+  const TimeRule time_rule = ft ? pointcloud2_time_rule(cloud, *ft, swap) : TimeRule{};
   scan.has_time = time_rule.valid;
+  if (time_rule.sets_stamp) scan.timestamp_s = time_rule.subtract_s;  // stamp 0: the earliest point
 
   for (std::size_t r = 0; r < height && width > 0; ++r) {  // width 0: no rows to walk
     const std::uint8_t* row = cloud.data + r * row_step;

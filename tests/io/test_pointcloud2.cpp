@@ -124,6 +124,21 @@ TEST(PointCloud2, TimeFieldConventions) {
   for (const LidarPoint& p : s.points) EXPECT_EQ(p.time_s, 0.f);
 }
 
+TEST(PointCloud2, AbsoluteTimesWithoutAStampReadAsPcdDoes) {
+  // A header stamp of 0 (some converters leave it unset) with absolute float64 seconds: as in
+  // a PCD file, the earliest point stands for the stamp, and the scan takes its time.
+  const auto pts = sample_points(30);  // times 0 .. 0.097 s
+  test::CloudLayout L;
+  L.time = test::TimeField::AbsoluteSecondsF64;
+  test::OwnedCloud c = test::make_cloud(pts, 1.6e9 + 0.25, L);
+  c.meta.stamp_sec = 0;
+  c.meta.stamp_nanosec = 0;
+  const auto bytes = test::encode_cdr(c, false);
+  const Scan s = pointcloud2_to_scan(decode_cdr_pointcloud2(bytes.data(), bytes.size(), "w"), "w");
+  EXPECT_NEAR(s.timestamp_s, 1.6e9 + 0.25, 1e-6);
+  expect_points(s, pts, L, 1e-6);
+}
+
 TEST(PointCloud2, BadCloudsAreErrors) {
   const auto pts = sample_points(10);
   test::OwnedCloud c = test::make_cloud(pts, 0.0, {});

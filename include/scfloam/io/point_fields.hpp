@@ -50,6 +50,9 @@ struct TimeRule {
 };
 TimeRule choose_time_rule(const unsigned char* data, std::size_t count, std::size_t stride, const CloudField& field,
                           bool big_endian, double stamp_s);
+// The same rule for a time field whose finite values span [lo, hi] (lo > hi: none finite), for
+// readers that walk their points differently (PointCloud2's padded rows).
+TimeRule time_rule_for_range(double lo, double hi, bool integer_field, double stamp_s);
 
 // Appends `count` points of `stride` bytes starting at `data` to `scan`, dropping points whose
 // x, y or z is not finite (organized clouds). Sets scan.has_ring / has_time when the layout has
