@@ -162,9 +162,12 @@ OdometryResult Odometry::process(const Scan& scan) {
   result.elevation_correction_deg = s.elevation          ? s.elevation->correction_deg()
                                     : s.ground_elevation ? s.ground_elevation->correction_deg()
                                                          : c.preprocess.elevation_correction_deg;
-  s.extractor.extract(*points, scan.has_ring && c.rings.use_ring_field, s.raw_edges, s.raw_planes);
+  // Only the first frame needs its planes at full density (below); the others' planes are
+  // downsampled from the runs the extractor summed per ring.
+  s.extractor.extract(*points, scan.has_ring && c.rings.use_ring_field, s.raw_edges,
+                      s.frames == 0 ? &s.raw_planes : nullptr);
   s.edge_filter.filter(s.raw_edges, c.features.edge_leaf_m, result.edges);
-  s.plane_filter.filter(s.raw_planes, c.features.plane_leaf_m, result.planes);
+  s.plane_filter.filter_runs(s.extractor.plane_runs(), result.planes);
   result.features_ms = watch.elapsed_ms();
   watch.restart();
 
@@ -298,7 +301,7 @@ void Odometry::redeskew_first_frames(const Eigen::Vector3d& omega_rad_s,
       s.map.insert(s.raw_edges, s.raw_planes, s.early_poses[0]);
     } else {
       s.edge_filter.filter(s.raw_edges, s.config.features.edge_leaf_m, edges);
-      s.plane_filter.filter(s.raw_planes, s.config.features.plane_leaf_m, planes);
+      s.plane_filter.filter_runs(s.extractor.plane_runs(), planes);
       s.map.insert(edges, planes, s.early_poses[1]);
     }
     std::vector<LidarPoint>().swap(points);  // not needed again

@@ -16,30 +16,17 @@ void VoxelFilter::Part::accumulate(const Eigen::Vector3f* begin, const Eigen::Ve
   index.reset(std::min(static_cast<std::size_t>(end - begin), expected_voxels) + 16);
   sums.clear();
   keys.clear();
-  // Feature clouds come ring by ring in azimuth order, so a run of consecutive points usually
-  // shares a voxel: sum the run in registers and probe the table only when the voxel changes.
-  // (Scalar sums: building an Eigen::Vector4f per point from x, y, z, 1 went through the stack
-  // and stalled on a failed store-to-load forward, ~25 ns a point.)
-  std::uint64_t run_key = 0;
-  float sx = 0, sy = 0, sz = 0, count = 0;
-  const auto flush = [&]() {
-    if (count == 0) return;
-    add(run_key, Eigen::Vector4f(sx, sy, sz, count));
-  };
-  for (const Eigen::Vector3f* p = begin; p != end; ++p) {
-    const Eigen::Vector3i c = voxel_coords(*p, inv);
-    const std::uint64_t key = voxel_key(c.x(), c.y(), c.z());
-    if (key != run_key) {
-      flush();
-      run_key = key;
-      sx = sy = sz = count = 0;
-    }
-    sx += p->x();
-    sy += p->y();
-    sz += p->z();
-    count += 1;
-  }
-  flush();
+  for_each_voxel_run(begin, end, inv, [&](std::uint64_t key, const Eigen::Vector4f& sum) { add(key, sum); });
+}
+
+void VoxelFilter::Part::add_runs(const VoxelRuns* begin, const VoxelRuns* end, std::size_t expected_voxels) {
+  std::size_t n = 0;
+  for (const VoxelRuns* r = begin; r != end; ++r) n += r->keys.size();
+  index.reset(std::min(n, expected_voxels) + 16);
+  sums.clear();
+  keys.clear();
+  for (const VoxelRuns* r = begin; r != end; ++r)
+    for (std::size_t i = 0; i < r->keys.size(); ++i) add(r->keys[i], r->sums[i]);
 }
 
 void VoxelFilter::Part::add(std::uint64_t key, const Eigen::Vector4f& sum) {
@@ -72,6 +59,31 @@ void VoxelFilter::filter(const FeatureCloud& in, double leaf_m, FeatureCloud& ou
                          [&] { second_.accumulate(p + half, p + n, inv, expected); });
     for (std::size_t i = 0; i < second_.sums.size(); ++i) first_.add(second_.keys[i], second_.sums[i]);
   }
+  write_centroids(out);
+}
+
+void VoxelFilter::filter_runs(const std::vector<VoxelRuns>& runs, FeatureCloud& out) {
+  const std::size_t expected = std::max<std::size_t>(last_voxels_, 1024);
+  std::size_t total = 0;
+  for (const VoxelRuns& r : runs) total += r.keys.size();
+  // As filter(): many runs in two parts on two threads, split where half the runs are done
+  // (a split fixed by the input, so the result does not depend on the scheduling).
+  constexpr std::size_t kParallelMin = 4096;
+  const VoxelRuns* b = runs.data();
+  const VoxelRuns* e = b + runs.size();
+  if (total < kParallelMin) {
+    first_.add_runs(b, e, expected);
+  } else {
+    const VoxelRuns* split = b;
+    for (std::size_t done = 0; split != e && 2 * done < total; ++split) done += split->keys.size();
+    tbb::parallel_invoke([&] { first_.add_runs(b, split, expected); },
+                         [&] { second_.add_runs(split, e, expected); });
+    for (std::size_t i = 0; i < second_.sums.size(); ++i) first_.add(second_.keys[i], second_.sums[i]);
+  }
+  write_centroids(out);
+}
+
+void VoxelFilter::write_centroids(FeatureCloud& out) {
   const std::vector<Eigen::Vector4f>& sums = first_.sums;
   last_voxels_ = sums.size();
   out.resize(sums.size());

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <cstdio>
@@ -7,6 +8,7 @@
 
 #include "scfloam/features/deskew.hpp"
 #include "scfloam/features/feature_extractor.hpp"
+#include "scfloam/registration/voxel_filter.hpp"
 
 namespace scfloam {
 namespace {
@@ -89,6 +91,25 @@ LidarPoint ring_point(const Eigen::Vector3d& p, int ring) {
   return lp;
 }
 
+// Known answers from sorting, on values with many ties (zeros, as on exact lines) and without.
+TEST(KthSmallest, EqualsTheSortedValueWithAndWithoutTies) {
+  std::mt19937 rng(3);
+  for (int trial = 0; trial < 200; ++trial) {
+    const int n = 1 + static_cast<int>(rng() % 700);
+    std::vector<float> v(static_cast<std::size_t>(n));
+    std::exponential_distribution<float> e(1.0f);
+    const unsigned distinct = trial % 3 == 0 ? 4u : 0u;  // a few distinct values, or all distinct
+    for (float& x : v) x = distinct ? static_cast<float>(rng() % distinct) : e(rng);
+    std::vector<float> sorted = v;
+    std::sort(sorted.begin(), sorted.end());
+    const int k = static_cast<int>(rng() % static_cast<unsigned>(n));
+    std::vector<float> work = v;
+    ASSERT_EQ(kth_smallest(work.data(), n, k), sorted[static_cast<std::size_t>(k)]) << trial;
+    std::sort(work.begin(), work.end());
+    ASSERT_EQ(work, sorted) << "the values are only reordered";
+  }
+}
+
 // A 64-beam scan of a room corner seen from inside: two walls meeting at a vertical edge.
 std::vector<LidarPoint> corner_room_scan() {
   std::vector<LidarPoint> pts;
@@ -136,6 +157,29 @@ TEST(FeatureExtractor, CornerSceneEdgesOnTheCornersPlanesOnTheWalls) {
   }
   // At most 20 edges per sector, 6 sectors, 64 rings.
   EXPECT_LE(edges.size(), 64u * 6u * 20u);
+}
+
+// The extractor's plane runs, summed ring by ring in its parallel pass, downsample to what the
+// voxel filter makes of its plane cloud: the odometry's path equals the plain one.
+TEST(FeatureExtractor, PlaneRunsDownsampleLikeTheFilterOfThePlanes) {
+  OdometryConfig c;
+  c.preprocess.max_range_m = 100;  // with the default elevation correction (applied before the runs)
+  FeatureExtractor extractor(c.preprocess, c.rings, c.features);
+  FeatureCloud edges, planes, by_runs, by_points, again;
+  extractor.extract(corner_room_scan(), true, edges, planes);
+  VoxelFilter filter;
+  filter.filter_runs(extractor.plane_runs(), by_runs);
+  by_points = voxel_downsample(planes, c.features.plane_leaf_m);
+  ASSERT_GT(by_points.size(), 100u);
+  ASSERT_EQ(by_runs.size(), by_points.size());
+  for (std::size_t i = 0; i < by_runs.size(); ++i) ASSERT_LT((by_runs[i] - by_points[i]).norm(), 1e-4f) << i;
+  // Without the plane cloud the runs are the same.
+  FeatureCloud edges2;
+  extractor.extract(corner_room_scan(), true, edges2, nullptr);
+  EXPECT_EQ(edges2.size(), edges.size());
+  filter.filter_runs(extractor.plane_runs(), again);
+  ASSERT_EQ(again.size(), by_runs.size());
+  for (std::size_t i = 0; i < again.size(); ++i) ASSERT_EQ(again[i], by_runs[i]) << i;
 }
 
 // LOAM's occlusion test: where a near wall ends in front of a far one, the far wall's points

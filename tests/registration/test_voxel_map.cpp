@@ -176,5 +176,46 @@ TEST(VoxelFilter, OneCentroidPerVoxel) {
   EXPECT_TRUE(out[2].isApprox(Eigen::Vector3f(-0.1f, 0.1f, 0.1f)));
 }
 
+
+// Runs summed elsewhere (the feature extractor sums each ring's) give the centroids filter()
+// gives for the same points in the same order, whether they fill one part or two.
+TEST(VoxelFilter, RunsGiveTheCentroidsOfThePointsInFirstSeenOrder) {
+  // A walk of small steps, so that consecutive points share voxels (runs of several points),
+  // revisiting voxels from other "rings".
+  std::mt19937 rng(5);
+  std::normal_distribution<float> step(0.f, 0.05f);
+  for (const std::size_t n : {500u, 60000u}) {  // one part; two halves on two threads
+    FeatureCloud cloud(n);
+    Eigen::Vector3f at(0.3f, -0.2f, 0.1f);
+    for (auto& p : cloud) {
+      at += Eigen::Vector3f(step(rng), step(rng), step(rng));
+      p = at;
+    }
+    const double leaf = 0.8;
+    std::vector<VoxelRuns> runs(7);  // uneven pieces, as rings are
+    std::size_t begin = 0;
+    for (std::size_t r = 0; r < runs.size(); ++r) {
+      const std::size_t end = r + 1 == runs.size() ? n : begin + n / (8 + r);
+      runs[r].append(cloud.data() + begin, cloud.data() + end, static_cast<float>(1.0 / leaf));
+      begin = end;
+    }
+    std::size_t total_runs = 0, total_points = 0;
+    for (const VoxelRuns& r : runs) {
+      total_runs += r.keys.size();
+      for (const auto& s : r.sums) total_points += static_cast<std::size_t>(s.w());
+    }
+    EXPECT_EQ(total_points, n);
+    EXPECT_LT(total_runs, n / 2) << "consecutive points should share voxels";
+    VoxelFilter by_runs, by_points;
+    FeatureCloud a, b;
+    by_runs.filter_runs(runs, a);
+    by_points.filter(cloud, leaf, b);
+    ASSERT_EQ(a.size(), b.size()) << n;
+    for (std::size_t i = 0; i < a.size(); ++i) ASSERT_LT((a[i] - b[i]).norm(), 1e-5f) << i;
+    by_runs.filter_runs(runs, a);  // again: the tables are reset between calls
+    EXPECT_EQ(a.size(), b.size());
+  }
+}
+
 }  // namespace
 }  // namespace scfloam

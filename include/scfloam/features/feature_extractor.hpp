@@ -12,6 +12,7 @@
 #include "scfloam/config.hpp"
 #include "scfloam/features/beam_layout.hpp"
 #include "scfloam/features/rings.hpp"
+#include "scfloam/registration/voxel_runs.hpp"
 #include "scfloam/types.hpp"
 
 namespace scfloam {
@@ -22,6 +23,10 @@ namespace scfloam {
 // dropped return, is not curvature; on evenly spaced points it is F-LOAM's value). Points
 // within half_window of either end get 0.
 void ring_curvature(const Eigen::Vector3f* points, int n, int half_window, float* curvature);
+
+// The k-th smallest of v[0, n) (0 <= k < n; v is reordered): the value std::nth_element finds,
+// by a quickselect whose partitions have no data-dependent branches (a ring's noise level).
+float kth_smallest(float* v, int n, int k);
 
 // Rotates each point up by `angle_deg` in its own vertical plane (KITTI's beams read ~0.22 deg
 // low); 0 leaves the points alone. Applied after ring assignment, which reads the sensor's own
@@ -58,6 +63,15 @@ class FeatureExtractor {
   // Buffers persist between calls: steady-state use allocates nothing.
   void extract(const std::vector<LidarPoint>& points, bool use_ring_field, FeatureCloud& edges,
                FeatureCloud& planes);
+  // The same, with `planes` == nullptr when only plane_runs() is wanted (no copy of ~100k
+  // plane points into one cloud).
+  void extract(const std::vector<LidarPoint>& points, bool use_ring_field, FeatureCloud& edges,
+               FeatureCloud* planes);
+  // After extract(): each ring's planes, in ring order, as runs of points in one
+  // features.plane_leaf_m voxel, summed in the parallel per-ring pass while the points are in
+  // cache. VoxelFilter::filter_runs makes them the downsampled planes with no pass over the
+  // points: the same centroids as VoxelFilter::filter of the planes, up to rounding.
+  const std::vector<VoxelRuns>& plane_runs() const { return ring_plane_runs_; }
   const FeatureStats& stats() const { return stats_; }
   void set_elevation_correction_deg(double deg) { pre_.elevation_correction_deg = deg; }
   const RingLayoutInfo& ring_layout() const { return layout_info_; }
@@ -91,6 +105,8 @@ class FeatureExtractor {
   std::vector<std::vector<int>> candidates_;     // per ring scratch
   std::vector<std::vector<float>> noise_scratch_;  // per ring: curvatures for the median
   std::vector<FeatureCloud> ring_edges_, ring_planes_;
+  std::vector<VoxelRuns> ring_plane_runs_;
+  float plane_inv_leaf_;                                       // 1 / features.plane_leaf_m
   std::vector<char> ring_resorted_;                            // per ring, last extract()
   std::vector<std::vector<std::pair<float, int>>> sort_scratch_;  // per ring
   std::vector<FeatureCloud> ring_copy_;                        // per ring

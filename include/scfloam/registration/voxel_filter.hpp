@@ -4,6 +4,7 @@
 #include <Eigen/Geometry>
 
 #include "scfloam/registration/voxel_hash.hpp"
+#include "scfloam/registration/voxel_runs.hpp"
 #include "scfloam/types.hpp"
 
 namespace scfloam {
@@ -14,6 +15,9 @@ class VoxelFilter {
   // Buffers are kept between calls, so steady-state use allocates nothing. Large clouds are
   // summed in two halves in parallel (TBB).
   void filter(const FeatureCloud& in, double leaf_m, FeatureCloud& out);
+  // The centroids of the points whose runs are runs[0], runs[1], ... in that order (summed in
+  // voxels of one size): what filter() gives for those points, up to the order of the sums.
+  void filter_runs(const std::vector<VoxelRuns>& runs, FeatureCloud& out);
 
  private:
   // Per-voxel sums of one run of points.
@@ -23,8 +27,10 @@ class VoxelFilter {
     std::vector<std::uint64_t> keys;    // the voxel of each sum
     void accumulate(const Eigen::Vector3f* begin, const Eigen::Vector3f* end, float inv,
                     std::size_t expected_voxels);
+    void add_runs(const VoxelRuns* begin, const VoxelRuns* end, std::size_t expected_voxels);
     void add(std::uint64_t key, const Eigen::Vector4f& sum);
   };
+  void write_centroids(FeatureCloud& out);
   Part first_, second_;
   std::size_t last_voxels_ = 0;  // voxels of the previous call: sizes the tables
 };
