@@ -143,6 +143,7 @@ float kth_smallest(float* v, int n, int k) {
   while (hi - lo > 16) {
     const float a = v[lo], b = v[lo + (hi - lo) / 2], c = v[hi - 1];
     const float pivot = std::max(std::min(a, b), std::min(std::max(a, b), c));  // median of three
+    if (!(pivot == pivot)) return pivot;  // NaN (curvatures have none): no partition could progress
     // v[lo, less) < pivot, then v[less, equal) == pivot: every swap is made, the cursor
     // advances by the comparison.
     int less = lo;

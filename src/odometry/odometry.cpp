@@ -43,7 +43,7 @@ struct Odometry::Impl {
   std::vector<LidarPoint> early_points[2];
   Eigen::Isometry3d early_poses[2];
   bool early_has_ring = false;
-  FeatureCloud raw_edges, raw_planes;
+  FeatureCloud raw_edges, raw_planes;  // raw_planes: filled on the first frame only
   FeatureCloud last_edges, last_planes;  // the previous frame's features, for the coarse pass
   std::size_t frames = 0;
   int rounds;
@@ -295,7 +295,7 @@ void Odometry::redeskew_first_frames(const Eigen::Vector3d& omega_rad_s,
   for (int k = 0; k < 2; ++k) {
     std::vector<LidarPoint>& points = s.early_points[k];
     deskew_constant_velocity(points, omega_rad_s, velocity_m_s);
-    s.extractor.extract(points, s.early_has_ring, s.raw_edges, s.raw_planes);
+    s.extractor.extract(points, s.early_has_ring, s.raw_edges, k == 0 ? &s.raw_planes : nullptr);
     if (k == 0) {
       // As on the first pass: frame 0 goes in at full density (see process()).
       s.map.insert(s.raw_edges, s.raw_planes, s.early_poses[0]);

@@ -180,6 +180,14 @@ TEST(FeatureExtractor, PlaneRunsDownsampleLikeTheFilterOfThePlanes) {
   filter.filter_runs(extractor.plane_runs(), again);
   ASSERT_EQ(again.size(), by_runs.size());
   for (std::size_t i = 0; i < again.size(); ++i) ASSERT_EQ(again[i], by_runs[i]) << i;
+  // A scan whose rings are too short for features leaves no runs of the last scan behind.
+  std::vector<LidarPoint> sparse = corner_room_scan();
+  std::vector<LidarPoint> few;
+  for (std::size_t i = 0; i < sparse.size(); i += 200) few.push_back(sparse[i]);  // 9 a ring
+  extractor.extract(few, true, edges2, nullptr);
+  for (const VoxelRuns& runs : extractor.plane_runs()) EXPECT_TRUE(runs.keys.empty() && runs.sums.empty());
+  filter.filter_runs(extractor.plane_runs(), again);
+  EXPECT_TRUE(again.empty());
 }
 
 // LOAM's occlusion test: where a near wall ends in front of a far one, the far wall's points

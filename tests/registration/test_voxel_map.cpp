@@ -212,9 +212,55 @@ TEST(VoxelFilter, RunsGiveTheCentroidsOfThePointsInFirstSeenOrder) {
     by_points.filter(cloud, leaf, b);
     ASSERT_EQ(a.size(), b.size()) << n;
     for (std::size_t i = 0; i < a.size(); ++i) ASSERT_LT((a[i] - b[i]).norm(), 1e-5f) << i;
-    by_runs.filter_runs(runs, a);  // again: the tables are reset between calls
-    EXPECT_EQ(a.size(), b.size());
+    FeatureCloud again;
+    by_runs.filter_runs(runs, again);  // the tables are reset between calls
+    EXPECT_EQ(again, a);
   }
+}
+
+// The runs' keys (four points at a time through SSE2, the rest one by one) are the voxels of
+// voxel_coords: points on both sides of zero in every lane, on voxel faces, lengths not a
+// multiple of four.
+TEST(VoxelRuns, KeysAreThoseOfVoxelCoordsInEveryLane) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(-40.f, 40.f);
+  std::uniform_int_distribution<int> face(-50, 50);
+  const float leaf = 0.8f, inv = 1.0f / leaf;
+  for (const std::size_t n : {1u, 3u, 4u, 7u, 1001u}) {
+    FeatureCloud cloud(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      cloud[i] = Eigen::Vector3f(u(rng), u(rng), u(rng));
+      if (i % 3 == 1) cloud[i][static_cast<int>(i % 7 % 3)] = static_cast<float>(face(rng)) * leaf;  // on a face
+      if (i % 5 == 2) cloud[i] = Eigen::Vector3f(-1e-4f, 1e-4f, -0.f);  // just either side of zero
+    }
+    VoxelRuns runs;
+    runs.append(cloud.data(), cloud.data() + n, inv);
+    // The expected runs, point by point.
+    std::vector<std::uint64_t> keys;
+    std::vector<float> counts;
+    for (const Eigen::Vector3f& p : cloud) {
+      const Eigen::Vector3i c = voxel_coords(p, inv);
+      const std::uint64_t key = voxel_key(c.x(), c.y(), c.z());
+      if (keys.empty() || keys.back() != key) {
+        keys.push_back(key);
+        counts.push_back(0);
+      }
+      counts.back() += 1;
+    }
+    ASSERT_EQ(runs.keys, keys) << n;
+    ASSERT_EQ(runs.sums.size(), counts.size());
+    for (std::size_t r = 0; r < counts.size(); ++r) EXPECT_EQ(runs.sums[r].w(), counts[r]) << r;
+  }
+  // Known voxels: floor, not truncation, below zero.
+  const FeatureCloud known{{-0.1f, 0.1f, 0.9f}, {0.79f, -0.81f, -1.5f}, {1.7f, 0.f, -0.f}, {-2.3f, 2.3f, 0.4f}, {0.5f, 0.5f, 0.5f}};
+  VoxelRuns runs;
+  runs.append(known.data(), known.data() + known.size(), inv);
+  ASSERT_EQ(runs.keys.size(), 5u);
+  EXPECT_EQ(runs.keys[0], voxel_key(-1, 0, 1));
+  EXPECT_EQ(runs.keys[1], voxel_key(0, -2, -2));
+  EXPECT_EQ(runs.keys[2], voxel_key(2, 0, 0));
+  EXPECT_EQ(runs.keys[3], voxel_key(-3, 2, 0));
+  EXPECT_EQ(runs.keys[4], voxel_key(0, 0, 0));
 }
 
 }  // namespace

@@ -26,6 +26,7 @@ void ring_curvature(const Eigen::Vector3f* points, int n, int half_window, float
 
 // The k-th smallest of v[0, n) (0 <= k < n; v is reordered): the value std::nth_element finds,
 // by a quickselect whose partitions have no data-dependent branches (a ring's noise level).
+// Values must not be NaN (one that is may come back as the answer).
 float kth_smallest(float* v, int n, int k);
 
 // Rotates each point up by `angle_deg` in its own vertical plane (KITTI's beams read ~0.22 deg
