@@ -3,10 +3,12 @@
 #include <ceres/ceres.h>
 
 #include <algorithm>
+#include <limits>
 
 #include <cstdio>
 
 #include "backend/pose_graph_costs.hpp"
+#include "scfloam/backend/loop_support.hpp"
 #include "scfloam/atomic_file.hpp"
 #include "scfloam/error.hpp"
 #include "scfloam/se3.hpp"
@@ -69,12 +71,15 @@ double PoseGraph::edge_chi2(std::size_t edge) const {
   return r.squaredNorm();
 }
 
-std::size_t PoseGraph::worst_loop(double min_chi2, std::size_t first_free_node) const {
+std::size_t PoseGraph::worst_loop(double min_chi2, std::size_t first_free_node,
+                                  const std::vector<char>* confirmed,
+                                  double confirmed_max_chi2) const {
   std::size_t worst = edges_.size();
   double worst_chi2 = min_chi2;
   for (std::size_t i = 0; i < edges_.size(); ++i) {
     if (!edges_[i].is_loop || !edges_[i].active || !in_window(edges_[i], first_free_node)) continue;
     const double chi2 = edge_chi2(i);
+    if (confirmed && (*confirmed)[i] && chi2 <= confirmed_max_chi2) continue;
     if (chi2 > worst_chi2) {
       worst_chi2 = chi2;
       worst = i;
@@ -83,30 +88,65 @@ std::size_t PoseGraph::worst_loop(double min_chi2, std::size_t first_free_node) 
   return worst;
 }
 
+std::vector<char> PoseGraph::confirmed_loops(const PoseGraphConfig& config) const {
+  const std::vector<std::size_t>& support = support_.update(edges_, size(), config);
+  std::vector<char> confirmed(edges_.size(), 0);
+  if (config.loop_support_min <= 0) return confirmed;
+  for (std::size_t i = 0; i < edges_.size(); ++i)
+    confirmed[i] = support[i] >= static_cast<std::size_t>(config.loop_support_min);
+  return confirmed;
+}
+
 PoseGraphReport PoseGraph::optimize(const PoseGraphConfig& config, std::size_t first_free_node) {
   Stopwatch watch;
+  // Loops that their neighbours confirm are trusted over the odometry chain: one switched off
+  // before its neighbours arrived is given back now, and none is judged or robustified below.
+  const std::vector<char> confirmed = confirmed_loops(config);
+  held_off_.resize(edges_.size(), 0);
+  PoseGraphReport report;
+  for (std::size_t i = 0; i < edges_.size(); ++i) {
+    if (!confirmed[i] || edges_[i].active || held_off_[i]) continue;
+    edges_[i].active = true;
+    report.restored_edges.push_back(i);
+  }
+  report.confirmed_loops =
+      static_cast<std::size_t>(std::count(confirmed.begin(), confirmed.end(), char{1}));
   // Least squares first: a bounded kernel from the drifted start would treat a genuine first
   // loop (metres of discrepancy) as an outlier. Inconsistent loops are pruned, then the
   // Cauchy kernel polishes from the closed configuration, where true loops fit well.
-  PoseGraphReport report = solve_once(config, /*robust=*/false, first_free_node);
+  const PoseGraphReport first = solve_once(config, nullptr, first_free_node);
+  report.iterations = first.iterations;
+  report.initial_cost = first.initial_cost;
+  report.final_cost = first.final_cost;
+  report.converged = first.converged;
   // A window cannot judge a loop: its anchored nodes may carry drift that only freeing them
   // would remove, so a true loop can misfit there and would be switched off for good. When a
-  // loop misfits in the window, the whole graph is solved and judges it instead.
-  std::size_t worst = worst_loop(config.loop_outlier_chi2, first_free_node);
-  if (first_free_node > 0 && worst < edges_.size()) {
+  // loop misfits in the window (a confirmed one too: the window may be what holds it open),
+  // the whole graph is solved and judges it instead.
+  const double confirmed_max_chi2 = config.loop_support_max_chi2;
+  if (first_free_node > 0 &&
+      worst_loop(config.loop_outlier_chi2, first_free_node, nullptr, 0) < edges_.size()) {
     first_free_node = 0;
     report.escalated = true;
-    report.iterations += solve_once(config, false, 0).iterations;
-    worst = worst_loop(config.loop_outlier_chi2, 0);
+    report.iterations += solve_once(config, nullptr, 0).iterations;
   }
   report.first_free_node = first_free_node;
   // Switch off the worst inconsistent loop only, then solve again: one false loop can make its
   // true neighbours look bad until it is gone.
+  // A confirmed loop is judged too when it misfits grossly (loop_support_max_chi2).
+  std::size_t worst =
+      worst_loop(config.loop_outlier_chi2, first_free_node, &confirmed, confirmed_max_chi2);
   for (int round = 0; round < config.max_outlier_rounds && worst < edges_.size(); ++round) {
     edges_[worst].active = false;
-    report.rejected_edges.push_back(worst);
-    report.iterations += solve_once(config, false, first_free_node).iterations;
-    worst = worst_loop(config.loop_outlier_chi2, first_free_node);
+    held_off_[worst] = confirmed[worst];  // not given back for its confirmation alone
+    // One given back above and off again was off before this solve: neither, in the report.
+    const auto given_back = std::find(report.restored_edges.begin(), report.restored_edges.end(), worst);
+    if (given_back != report.restored_edges.end())
+      report.restored_edges.erase(given_back);
+    else
+      report.rejected_edges.push_back(worst);
+    report.iterations += solve_once(config, nullptr, first_free_node).iterations;
+    worst = worst_loop(config.loop_outlier_chi2, first_free_node, &confirmed, confirmed_max_chi2);
   }
   // A false loop can pull a true neighbour further out than itself, so the neighbour goes off
   // first, in this solve or an earlier one; once the false one is off too, the neighbour fits
@@ -116,18 +156,20 @@ PoseGraphReport PoseGraph::optimize(const PoseGraphConfig& config, std::size_t f
     if (!edges_[i].is_loop || edges_[i].active || !in_window(edges_[i], first_free_node)) continue;
     if (edge_chi2(i) >= config.loop_outlier_chi2) continue;
     edges_[i].active = restored = true;
+    held_off_[i] = 0;
     const auto rejected = std::find(report.rejected_edges.begin(), report.rejected_edges.end(), i);
     if (rejected != report.rejected_edges.end())
       report.rejected_edges.erase(rejected);
     else
       report.restored_edges.push_back(i);
   }
-  if (restored) report.iterations += solve_once(config, false, first_free_node).iterations;
+  if (restored) report.iterations += solve_once(config, nullptr, first_free_node).iterations;
   // Where every loop fits well within the kernel's scale the Cauchy solution is the
   // least-squares one to within tolerance: skip the extra solve.
   const double polish_chi2 = 0.25 * config.loop_cauchy_scale * config.loop_cauchy_scale;
-  if (worst_loop(polish_chi2, first_free_node) < edges_.size()) {
-    const PoseGraphReport polished = solve_once(config, true, first_free_node);
+  if (worst_loop(polish_chi2, first_free_node, &confirmed, std::numeric_limits<double>::infinity()) <
+      edges_.size()) {
+    const PoseGraphReport polished = solve_once(config, &confirmed, first_free_node);
     report.iterations += polished.iterations;
     report.final_cost = polished.final_cost;
     report.converged = polished.converged;
@@ -136,7 +178,8 @@ PoseGraphReport PoseGraph::optimize(const PoseGraphConfig& config, std::size_t f
   return report;
 }
 
-PoseGraphReport PoseGraph::solve_once(const PoseGraphConfig& config, bool robust,
+PoseGraphReport PoseGraph::solve_once(const PoseGraphConfig& config,
+                                      const std::vector<char>* robust_except,
                                       std::size_t first_free_node) {
   PoseGraphReport report;
   if (size() < 2 || edges_.empty()) return report;
@@ -146,10 +189,14 @@ PoseGraphReport PoseGraph::solve_once(const PoseGraphConfig& config, bool robust
   ceres::Problem problem(problem_options);
   PoseManifold manifold;
   ceres::CauchyLoss loop_loss(config.loop_cauchy_scale);
+  // With robust_except, loops take the Cauchy kernel except those it marks (confirmed loops).
+  auto robust = [&](const PoseGraphEdge& e) {
+    return robust_except && e.is_loop && !(*robust_except)[static_cast<std::size_t>(&e - edges_.data())];
+  };
   for (const auto& e : edges_) {
     if (!e.active || !in_window(e, first_free_node)) continue;
     problem.AddResidualBlock(new RelativePoseCost(e.T_from_to, e.sqrt_information),
-                             e.is_loop && robust ? &loop_loss : nullptr, nodes_[e.from].data(),
+                             robust(e) ? &loop_loss : nullptr, nodes_[e.from].data(),
                              nodes_[e.to].data());
   }
   for (auto& node : nodes_)

@@ -189,6 +189,7 @@ void LoopClosure::solve(bool whole_graph) {
   whole_solve_due_ = first_free > 0;
   window_solves_ += first_free > 0;
   escalated_solves_ += report.escalated;
+  confirmed_loops_ = report.confirmed_loops;
   earliest_partner_ = std::numeric_limits<std::size_t>::max();
   earliest_current_ = std::numeric_limits<std::size_t>::max();
   unsolved_loops_ = false;

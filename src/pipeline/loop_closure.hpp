@@ -55,6 +55,8 @@ class LoopClosure {
   std::size_t window_solves() const { return window_solves_; }
   // Window solves in which a loop misfit, so that the whole graph was solved to judge it.
   std::size_t escalated_solves() const { return escalated_solves_; }
+  // Loops confirmed by their neighbours at the last solve (pose_graph.loop_support_*).
+  std::size_t confirmed_loops() const { return confirmed_loops_; }
 
  private:
   std::vector<KeyframeView> submap_around(std::size_t loop_kf, std::size_t limit,
@@ -85,7 +87,7 @@ class LoopClosure {
   std::vector<double> registration_ms_, optimization_ms_, heap_trim_ms_;
   std::function<void(const SolveSample&)> on_solve_;
   std::size_t solves_skipped_ = 0, solves_deferred_ = 0, window_solves_ = 0,
-              escalated_solves_ = 0;
+              escalated_solves_ = 0, confirmed_loops_ = 0;
   std::size_t pending_deferred_ = 0;  // deferred loops not yet solved
   std::size_t earliest_partner_;      // of the loops added since the last solve
   std::size_t earliest_current_;      // newer end of the earliest loop since the last solve

@@ -171,7 +171,9 @@ nlohmann::json make_summary(const ScanSource& source, const RunResult& result) {
                         {"solves_skipped", result.loop_solves_skipped},
                         {"solves_deferred", result.loop_solves_deferred},
                         {"window_solves", result.window_solves},
-                        {"escalated_solves", result.escalated_solves}};
+                        {"escalated_solves", result.escalated_solves},
+                        // loops that close consistent short cycles with their neighbours
+                        {"confirmed", result.confirmed_loops}};
   }
   // Accuracy against the source's ground truth, when it has one for every processed frame.
   const PoseList gt_lidar = source.ground_truth_lidar();

@@ -467,6 +467,7 @@ RunResult run_slam(const ScanSource& source, const SlamConfig& base_config,
     result.loop_solves_deferred = closure.solves_deferred();
     result.window_solves = closure.window_solves();
     result.escalated_solves = closure.escalated_solves();
+    result.confirmed_loops = closure.confirmed_loops();
     result.loop_rows = closure.log().rows();
     result.graph = std::make_shared<PoseGraph>(closure.graph());
   }

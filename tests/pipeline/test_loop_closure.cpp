@@ -27,7 +27,9 @@ struct Drive {
   std::vector<std::shared_ptr<Keyframe>> keyframes;
 };
 
-Drive make_drive(double scale_error, double yaw_bias_deg_per_100m) {
+// The odometry drifts in scale and heading; with failure_deg it also over-turns by that much
+// in the ten frames from frame 200 (a heading failure in one turn, on the first lap).
+Drive make_drive(double scale_error, double yaw_bias_deg_per_100m, double failure_deg = 0.0) {
   {
     const SlamConfig config;
     const sim::Scenario scenario = sim::make_loops_scenario(3, 1000);
@@ -37,6 +39,17 @@ Drive make_drive(double scale_error, double yaw_bias_deg_per_100m) {
     Drive out;
     for (std::size_t k = 0; k < scenario.frames; ++k) out.gt.push_back(scenario.frame_pose(k));
     out.odometry = test::drifting_odometry(out.gt, scale_error, yaw_bias_deg_per_100m);
+    if (failure_deg != 0.0) {
+      const std::size_t from = 200, to = 210;
+      PoseList failed{out.odometry.front()};
+      for (std::size_t k = 1; k < out.odometry.size(); ++k) {
+        Eigen::Isometry3d step = out.odometry[k - 1].inverse() * out.odometry[k];
+        if (k >= from && k < to)
+          step.linear() = step.linear() * so3_exp(Eigen::Vector3d(0, 0, failure_deg / (to - from) * M_PI / 180.0));
+        failed.push_back(failed.back() * step);
+      }
+      out.odometry = failed;
+    }
     // Keyframes on the odometry, as the pipeline picks them.
     KeyframeSelector selector(config.loop_detection.keyframe_distance_m,
                               config.loop_detection.keyframe_angle_deg * M_PI / 180.0);
@@ -67,6 +80,11 @@ Drive make_drive(double scale_error, double yaw_bias_deg_per_100m) {
 
 const Drive& drifting_drive() {  // 1 % scale, 1 deg per 100 m
   static const Drive d = make_drive(0.01, 1.0);
+  return d;
+}
+
+const Drive& heading_failure_drive() {  // accurate, but 18 deg lost in one turn
+  static const Drive d = make_drive(0.0005, 0.02, 18.0);
   return d;
 }
 
@@ -265,6 +283,7 @@ TEST(LoopClosure, SolvesABacklogsLoopsTogetherAndStillCorrectsTheDrift) {
   EXPECT_LE(solves, (needing_solve + 4) / 5 + 1);
   EXPECT_LT(solves, needing_solve);
   expect_active_loops_fit(closure.graph(), config);
+  expect_right_loops_active(d, closure.graph());
   const Accuracy a = keyframe_accuracy(d, store);
   std::printf("ATE odometry %.2f m, corrected %.2f m\n", a.ate_odometry, a.ate_corrected);
   EXPECT_LE(a.ate_corrected, 0.6 * a.ate_odometry);
@@ -286,4 +305,41 @@ TEST(LoopClosure, AddsLoopsTheGraphAgreesWithWithoutASolve) {
   expect_active_loops_fit(closure.graph(), config);
   const Accuracy a = keyframe_accuracy(d, store);
   EXPECT_LE(a.ate_corrected, a.ate_odometry + 0.05);  // the solve does no harm
+}
+
+// The odometry loses 18 degrees of heading in one turn of the first lap; the revisit's loops
+// each misfit the odometry chain's sigmas, and the graph's chi-square test used to switch every
+// one off as it arrived (the keyframes stayed where the odometry put them). They confirm each
+// other through short cycles (pose_graph.loop_support_*): kept, and the drive is corrected.
+TEST(LoopClosure, ClosesLoopsAcrossAHeadingFailureOfTheOdometry) {
+  const Drive& d = heading_failure_drive();
+  auto run = [&](const SlamConfig& config, KeyframeStore& store) {
+    LoopClosure closure(config, LoopRegistrationMethod::kFeatures, store);
+    close_loops(d, config, /*backlog=*/false, store, closure);
+    return closure.confirmed_loops();
+  };
+  SlamConfig unsupported;
+  unsupported.pose_graph.loop_support_span_keyframes = 0;
+  KeyframeStore judged_store;
+  EXPECT_EQ(run(unsupported, judged_store), 0u);
+  const Accuracy judged = keyframe_accuracy(d, judged_store);
+
+  const SlamConfig config;
+  KeyframeStore store;
+  LoopClosure closure(config, LoopRegistrationMethod::kFeatures, store);
+  close_loops(d, config, /*backlog=*/false, store, closure);
+  const Accuracy a = keyframe_accuracy(d, store);
+  std::printf("%zu keyframes, %zu loops accepted, %zu confirmed: ATE odometry %.2f m, corrected "
+              "%.2f m (%.2f m without confirmation)\n",
+              d.frames.size(), closure.accepted_loops(), closure.confirmed_loops(), a.ate_odometry,
+              a.ate_corrected, judged.ate_corrected);
+  ASSERT_GT(a.ate_odometry, 5.0);  // the failure is real
+  EXPECT_GT(judged.ate_corrected, 0.8 * a.ate_odometry);  // what the chi-square test alone left
+  EXPECT_GE(closure.confirmed_loops(), 10u);
+  EXPECT_LE(a.ate_corrected, 0.3 * a.ate_odometry);
+  expect_right_loops_active(d, closure.graph());
+  for (const auto& row : closure.log().rows()) {
+    if (row.verdict != LoopVerdict::kAccepted) continue;
+    EXPECT_LT((d.gt[row.current_frame].translation() - d.gt[row.loop_frame].translation()).norm(), 10.0);
+  }
 }

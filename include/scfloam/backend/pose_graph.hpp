@@ -1,7 +1,8 @@
 // Keyframe pose graph on Ceres: nodes are keyframe poses T_world_kf, edges are measured
 // relative poses T_i_j (odometry between consecutive keyframes, loops from registration).
 //
-// Robustness against wrong loops, in two layers (docs/loop_closure.md, "Pose graph"):
+// Robustness against wrong loops, in two layers (docs/loop_closure.md, "Pose graph"), which
+// loops confirmed by their neighbours are exempt from (loop_support.hpp):
 // - loop edges carry a Cauchy kernel in the final solve, so a mildly inconsistent loop pulls
 //   less;
 // - after a least-squares solve, a loop whose whitened residual is still beyond a chi-square
@@ -18,20 +19,12 @@
 #include <filesystem>
 #include <vector>
 
+#include "scfloam/backend/loop_support.hpp"
 #include "scfloam/backend/pose_graph_config.hpp"
+#include "scfloam/backend/pose_graph_edge.hpp"
 #include "scfloam/types.hpp"
 
 namespace scfloam {
-
-struct PoseGraphEdge {
-  std::size_t from = 0, to = 0;
-  Eigen::Isometry3d T_from_to = Eigen::Isometry3d::Identity();
-  // Square root of the information matrix; the residual is [Log(R_err); t_err] of the error
-  // transform E = T_from_to^-1 * (T_world_from^-1 * T_world_to).
-  Eigen::Matrix<double, 6, 6> sqrt_information = Eigen::Matrix<double, 6, 6>::Identity();
-  bool is_loop = false;
-  bool active = true;  // false while the solver finds the loop inconsistent
-};
 
 struct PoseGraphReport {
   int iterations = 0;
@@ -39,11 +32,14 @@ struct PoseGraphReport {
   double solve_ms = 0;
   bool converged = false;
   std::vector<std::size_t> rejected_edges;  // indices into edges() switched off by this solve
-  std::vector<std::size_t> restored_edges;  // loops switched off earlier that fit again
+  // Loops switched off earlier that fit again, or that their neighbours now confirm.
+  std::vector<std::size_t> restored_edges;
   // The window actually solved: a windowed solve in which a loop misfits is escalated to the
   // whole graph (first_free_node 0), which alone judges loops.
   std::size_t first_free_node = 0;
   bool escalated = false;
+  // Loops confirmed by their neighbours (never switched off, never robustified).
+  std::size_t confirmed_loops = 0;
 };
 
 // Square-root information for independent rotation/translation sigmas.
@@ -73,6 +69,9 @@ class PoseGraph {
   // Squared whitened residual of an edge under the current estimate.
   double edge_chi2(std::size_t edge) const;
   std::size_t loop_edge_count() const;
+  // Per edge: 1 for a loop confirmed by its neighbours (loop_support.hpp, config.loop_support_*).
+  // Not thread-safe even though const: it brings a cache of the counts up to date.
+  std::vector<char> confirmed_loops(const PoseGraphConfig& config) const;
 
   // g2o text format (VERTEX_SE3:QUAT / EDGE_SE3:QUAT, information in g2o's [t, r] order),
   // readable by g2o and GTSAM's readG2o. Written atomically.
@@ -83,10 +82,19 @@ class PoseGraph {
   std::vector<std::array<double, 7>> nodes_;
   std::vector<PoseGraphEdge> edges_;
 
-  PoseGraphReport solve_once(const PoseGraphConfig& config, bool robust,
+  // robust_except: null for least squares; else loops take the Cauchy kernel except those marked.
+  PoseGraphReport solve_once(const PoseGraphConfig& config, const std::vector<char>* robust_except,
                              std::size_t first_free_node);
-  // The active loop in the window with the largest chi2 above min_chi2, or edges_.size().
-  std::size_t worst_loop(double min_chi2, std::size_t first_free_node) const;
+  // The active loop in the window with the largest chi2 above min_chi2, or edges_.size();
+  // loops marked in `confirmed` are passed over unless their chi2 exceeds confirmed_max_chi2.
+  std::size_t worst_loop(double min_chi2, std::size_t first_free_node,
+                         const std::vector<char>* confirmed, double confirmed_max_chi2) const;
+  // Kept up to date as edges are added (the counts depend on the measurements only).
+  mutable LoopSupport support_;
+  // Per edge: a confirmed loop switched off for a gross misfit (loop_support_max_chi2); it
+  // comes back only by fitting, not by its confirmation (which would switch it on and off in
+  // every solve).
+  std::vector<char> held_off_;
   bool in_window(const PoseGraphEdge& e, std::size_t first_free_node) const {
     return e.from >= first_free_node || e.to >= first_free_node;
   }

@@ -17,6 +17,25 @@ struct PoseGraphConfig {
   // (chi-square, 6 dof: 22.46 is the 99.9 % quantile).
   double loop_outlier_chi2 = 22.46;
   int max_outlier_rounds = 3;
+  // A loop that closes a consistent short cycle with at least loop_support_min other loops
+  // (their ends within loop_support_span_keyframes of its own on the odometry chain; the cycle
+  // loop, odometry, other loop, odometry within loop_support_translation_m and
+  // loop_support_rotation_deg of the identity) is confirmed: the chi-square test above does not
+  // switch it off and the Cauchy kernel does not weaken it. A heading failure of the odometry
+  // (14 degrees in one turn, measured) leaves every loop across it misfitting the chain's
+  // sigmas, and the test would switch all of them off; the loops agree with each other, and
+  // that is the evidence that the chain, not they, went wrong (docs/loop_closure.md, "Loops
+  // that confirm each other"). loop_support_span_keyframes 0: no loop is confirmed.
+  int loop_support_min = 2;
+  int loop_support_span_keyframes = 10;
+  double loop_support_translation_m = 0.3;
+  double loop_support_rotation_deg = 0.5;
+  // ... but a confirmed loop whose squared whitened residual after least squares is above this
+  // (10x the test's bound: 1.5 m at the loop's 0.1 m sigma) is judged like any other: a group
+  // of mutually consistent false loops (one repeated structure matched the same wrong way) must
+  // not bend the graph without limit. Measured true loops after an 18 / 30 degree failure:
+  // at most 27 / 111.
+  double loop_support_max_chi2 = 224.6;
   // A new loop whose squared whitened residual under the current estimate is below this is
   // added without a solve: the graph already agrees with it (0.05: about 2 cm at the default
   // 0.1 m sigma). On a revisited route most loops after the first one are like that, and a

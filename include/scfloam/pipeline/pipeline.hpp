@@ -98,6 +98,7 @@ struct RunResult {
   std::size_t loop_solves_deferred = 0;  // accepted loops solved later, with a backlog's others
   std::size_t window_solves = 0;     // graph solves that freed only a window of recent nodes
   std::size_t escalated_solves = 0;  // window solves escalated to the whole graph by a misfit loop
+  std::size_t confirmed_loops = 0;   // loops confirmed by their neighbours at the last solve
   std::shared_ptr<const PoseGraph> graph;
   PoseList keyframe_poses;  // final pose of every keyframe
   KeyframeStorageStats keyframe_storage;
