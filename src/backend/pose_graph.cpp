@@ -103,22 +103,19 @@ PoseGraphReport PoseGraph::optimize(const PoseGraphConfig& config, std::size_t f
   // before its neighbours arrived is given back now, and none is judged or robustified below.
   const std::vector<char> confirmed = confirmed_loops(config);
   held_off_.resize(edges_.size(), 0);
-  PoseGraphReport report;
+  std::vector<std::size_t> given_back;
   for (std::size_t i = 0; i < edges_.size(); ++i) {
     if (!confirmed[i] || edges_[i].active || held_off_[i]) continue;
     edges_[i].active = true;
-    report.restored_edges.push_back(i);
+    given_back.push_back(i);
   }
-  report.confirmed_loops =
-      static_cast<std::size_t>(std::count(confirmed.begin(), confirmed.end(), char{1}));
   // Least squares first: a bounded kernel from the drifted start would treat a genuine first
   // loop (metres of discrepancy) as an outlier. Inconsistent loops are pruned, then the
   // Cauchy kernel polishes from the closed configuration, where true loops fit well.
-  const PoseGraphReport first = solve_once(config, nullptr, first_free_node);
-  report.iterations = first.iterations;
-  report.initial_cost = first.initial_cost;
-  report.final_cost = first.final_cost;
-  report.converged = first.converged;
+  PoseGraphReport report = solve_once(config, nullptr, first_free_node);
+  report.restored_edges = std::move(given_back);
+  report.confirmed_loops =
+      static_cast<std::size_t>(std::count(confirmed.begin(), confirmed.end(), char{1}));
   // A window cannot judge a loop: its anchored nodes may carry drift that only freeing them
   // would remove, so a true loop can misfit there and would be switched off for good. When a
   // loop misfits in the window (a confirmed one too: the window may be what holds it open),

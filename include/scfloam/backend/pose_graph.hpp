@@ -38,7 +38,7 @@ struct PoseGraphReport {
   // whole graph (first_free_node 0), which alone judges loops.
   std::size_t first_free_node = 0;
   bool escalated = false;
-  // Loops confirmed by their neighbours (never switched off, never robustified).
+  // Loops confirmed by their neighbours: not robustified, switched off only for a gross misfit.
   std::size_t confirmed_loops = 0;
 };
 
