@@ -108,8 +108,9 @@ std::vector<unsigned char> pack_ascii(const std::filesystem::path& path, const P
   return rows;
 }
 
-// binary_compressed stores each field's values for all points together (struct of arrays).
-std::vector<unsigned char> unpack_compressed(const std::filesystem::path& path, const PcdHeader& h,
+// binary_compressed stores each field's values for all points together (struct of arrays),
+// which the readers' conversion takes as it is (append_columns).
+std::vector<unsigned char> decompress_columns(const std::filesystem::path& path, const PcdHeader& h,
                                              const std::string& bytes) {
   if (bytes.size() < h.data_begin + 8) throw file_error(path, "PCD binary_compressed data is truncated (no sizes)");
   std::uint32_t packed = 0, unpacked = 0;
@@ -121,17 +122,9 @@ std::vector<unsigned char> unpack_compressed(const std::filesystem::path& path, 
   if (bytes.size() - h.data_begin - 8 < packed)
     throw file_error(path, "PCD binary_compressed data is truncated (" + std::to_string(bytes.size() - h.data_begin - 8) +
                                " of " + std::to_string(packed) + " compressed bytes)");
-  const auto columns = lzf_decompress(reinterpret_cast<const unsigned char*>(bytes.data()) + h.data_begin + 8, packed, unpacked);
+  auto columns = lzf_decompress(reinterpret_cast<const unsigned char*>(bytes.data()) + h.data_begin + 8, packed, unpacked);
   if (!columns) throw file_error(path, "PCD binary_compressed data is corrupt (LZF stream does not decode)");
-  std::vector<unsigned char> rows(unpacked);
-  std::size_t column_begin = 0;
-  for (const auto& f : h.fields) {
-    const std::size_t width = field_type_size(f.type) * f.count;
-    for (std::size_t i = 0; i < h.points; ++i)
-      std::memcpy(rows.data() + i * h.point_step + f.offset, columns->data() + column_begin + i * width, width);
-    column_begin += width * h.points;
-  }
-  return rows;
+  return std::move(*columns);
 }
 
 }  // namespace
@@ -168,8 +161,12 @@ PointCloudFile read_pcd(const std::filesystem::path& path) {
   } else if (h.points > 0xffffffffu / h.point_step) {
     throw file_error(path, "PCD binary_compressed: " + std::to_string(h.points) + " points exceed the format's 4 GiB");
   }
-  const auto rows = h.data == "ascii" ? pack_ascii(path, h, bytes) : unpack_compressed(path, h, bytes);
-  append_points(rows.data(), h.points, h.point_step, h.fields, layout, false, file.scan);
+  if (h.data == "ascii") {
+    const auto rows = pack_ascii(path, h, bytes);
+    append_points(rows.data(), h.points, h.point_step, h.fields, layout, false, file.scan);
+  } else {
+    append_columns(decompress_columns(path, h, bytes).data(), h.points, h.fields, layout, file.scan);
+  }
   return file;
 }
 

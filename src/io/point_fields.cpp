@@ -7,6 +7,7 @@
 #include <cstring>
 #include <initializer_list>
 #include <limits>
+#include <type_traits>
 
 #include "scfloam/error.hpp"
 #include "scfloam/io/field_names.hpp"
@@ -19,35 +20,44 @@ std::string lower(std::string s) {
   return s;
 }
 
-template <typename T>
-T load_as(const unsigned char* p, bool swap) {
+template <typename T, bool Swap>
+T load(const unsigned char* p) {
   unsigned char bytes[sizeof(T)];
   std::memcpy(bytes, p, sizeof(T));
-  if (swap) std::reverse(bytes, bytes + sizeof(T));
+  if constexpr (Swap) std::reverse(bytes, bytes + sizeof(T));
   T v;
   std::memcpy(&v, bytes, sizeof(T));
   return v;
 }
 
-double read_value(const unsigned char* p, FieldType type, bool swap) {
-  switch (type) {
-    case FieldType::kInt8: return load_as<std::int8_t>(p, false);
-    case FieldType::kUint8: return load_as<std::uint8_t>(p, false);
-    case FieldType::kInt16: return load_as<std::int16_t>(p, swap);
-    case FieldType::kUint16: return load_as<std::uint16_t>(p, swap);
-    case FieldType::kInt32: return load_as<std::int32_t>(p, swap);
-    case FieldType::kUint32: return load_as<std::uint32_t>(p, swap);
-    case FieldType::kFloat32: return load_as<float>(p, swap);
-    case FieldType::kFloat64: return load_as<double>(p, swap);
+// Calls sink(i, value) for the field of points first .. first + count - 1 (i from 0), the type
+// and byte order resolved once per call so that the loop itself is a plain typed load.
+template <typename Sink>
+void for_each_value(const unsigned char* data, std::size_t first, std::size_t count, std::size_t stride,
+                    FieldSlot slot, bool swap, Sink&& sink) {
+  if (slot.stride != 0) stride = slot.stride;
+  auto run = [&](auto value_type, auto swapped) {
+    using T = decltype(value_type);
+    const unsigned char* p = data + slot.offset + first * stride;
+    for (std::size_t i = 0; i < count; ++i, p += stride)
+      sink(i, static_cast<double>(load<T, decltype(swapped)::value>(p)));
+  };
+  auto typed = [&](auto value_type) {
+    if (swap && sizeof(value_type) > 1)
+      run(value_type, std::true_type{});
+    else
+      run(value_type, std::false_type{});
+  };
+  switch (slot.type) {
+    case FieldType::kInt8: return typed(std::int8_t{});
+    case FieldType::kUint8: return typed(std::uint8_t{});
+    case FieldType::kInt16: return typed(std::int16_t{});
+    case FieldType::kUint16: return typed(std::uint16_t{});
+    case FieldType::kInt32: return typed(std::int32_t{});
+    case FieldType::kUint32: return typed(std::uint32_t{});
+    case FieldType::kFloat32: return typed(float{});
+    case FieldType::kFloat64: return typed(double{});
   }
-  return 0;
-}
-
-bool host_is_big_endian() {
-  const std::uint16_t one = 1;
-  unsigned char first;
-  std::memcpy(&first, &one, 1);
-  return first == 0;
 }
 
 }  // namespace
@@ -139,19 +149,6 @@ PointLayout map_point_fields(const std::vector<CloudField>& fields) {
 
 bool is_integer(FieldType type) { return type != FieldType::kFloat32 && type != FieldType::kFloat64; }
 
-TimeRule choose_time_rule(const unsigned char* data, std::size_t count, std::size_t stride, const CloudField& field,
-                          bool big_endian, double stamp_s) {
-  const bool swap = big_endian != host_is_big_endian();
-  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-  for (std::size_t i = 0; i < count; ++i) {
-    const double t = read_value(data + i * stride + field.offset, field.type, swap);
-    if (!std::isfinite(t)) continue;
-    lo = std::min(lo, t);
-    hi = std::max(hi, t);
-  }
-  return time_rule_for_range(lo, hi, is_integer(field.type), stamp_s);
-}
-
 TimeRule time_rule_for_range(double lo, double hi, bool integer_field, double stamp_s) {
   constexpr double kMaxScanSpanS = 1.5;  // slower than any spinning LiDAR's sweep
   if (!(lo <= hi)) return {};
@@ -171,44 +168,130 @@ TimeRule time_rule_for_range(double lo, double hi, bool integer_field, double st
   return {};
 }
 
+namespace {
+
+// append_points and append_columns once each field has its slot.
+void append_slots(const unsigned char* data, std::size_t count, std::size_t stride, const PointSlots& slots,
+                  std::optional<FieldType> time_type, bool big_endian, Scan& scan) {
+  const bool swap = big_endian != host_is_big_endian();
+  TimeRule time_rule;
+  if (slots.time) {
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    widen_field_range(data, count, stride, *slots.time, swap, lo, hi);
+    time_rule = time_rule_for_range(lo, hi, is_integer(*time_type), scan.timestamp_s);
+  }
+  if (time_rule.sets_stamp) scan.timestamp_s = time_rule.subtract_s;
+  scan.points.reserve(scan.points.size() + count);
+  append_point_run(data, count, stride, slots, swap, time_rule, scan.points);
+  scan.has_ring = slots.ring.has_value();
+  scan.has_time = time_rule.valid;
+}
+
+PointSlots slots_of(const PointLayout& layout, const std::vector<FieldSlot>& slot_of_field) {
+  auto slot = [&](int index) -> std::optional<FieldSlot> {
+    if (index < 0) return std::nullopt;
+    return slot_of_field.at(static_cast<std::size_t>(index));
+  };
+  return {*slot(layout.x), *slot(layout.y), *slot(layout.z), slot(layout.intensity), slot(layout.ring),
+          slot(layout.time)};
+}
+
+std::optional<FieldType> time_type(const std::vector<CloudField>& fields, const PointLayout& layout) {
+  if (layout.time < 0) return std::nullopt;
+  return fields.at(static_cast<std::size_t>(layout.time)).type;
+}
+
+}  // namespace
+
 void append_points(const unsigned char* data, std::size_t count, std::size_t stride,
                    const std::vector<CloudField>& fields, const PointLayout& layout,
                    bool big_endian, Scan& scan) {
-  const bool swap = big_endian != host_is_big_endian();
-  const CloudField& fx = fields.at(layout.x);
-  const CloudField& fy = fields.at(layout.y);
-  const CloudField& fz = fields.at(layout.z);
-  const CloudField* fi = layout.intensity >= 0 ? &fields[layout.intensity] : nullptr;
-  const CloudField* fr = layout.ring >= 0 ? &fields[layout.ring] : nullptr;
-  const CloudField* ft = layout.time >= 0 ? &fields[layout.time] : nullptr;
-  const TimeRule time_rule = ft ? choose_time_rule(data, count, stride, *ft, big_endian, scan.timestamp_s) : TimeRule{};
-  if (time_rule.sets_stamp) scan.timestamp_s = time_rule.subtract_s;
-  scan.points.reserve(scan.points.size() + count);
-  for (std::size_t i = 0; i < count; ++i) {
-    const unsigned char* p = data + i * stride;
-    LidarPoint q;
-    const double x = read_value(p + fx.offset, fx.type, swap);
-    const double y = read_value(p + fy.offset, fy.type, swap);
-    const double z = read_value(p + fz.offset, fz.type, swap);
-    // A float64 field can hold finite values beyond float's range, which would become inf here.
-    if (!fits_float(x) || !fits_float(y) || !fits_float(z)) continue;
-    q.x = static_cast<float>(x);
-    q.y = static_cast<float>(y);
-    q.z = static_cast<float>(z);
-    if (fi) {
-      const double v = read_value(p + fi->offset, fi->type, swap);
-      q.intensity = fits_float(v) ? static_cast<float>(v) : 0.f;
-    }
-    if (fr) q.ring = ring_from_value(read_value(p + fr->offset, fr->type, swap));
-    if (time_rule.valid) {
-      const double t = read_value(p + ft->offset, ft->type, swap);
-      q.time_s = static_cast<float>(t * time_rule.scale - time_rule.subtract_s);
-      if (!std::isfinite(q.time_s)) q.time_s = 0;
-    }
-    scan.points.push_back(q);
+  std::vector<FieldSlot> slot_of_field;
+  for (const CloudField& f : fields) slot_of_field.push_back({f.offset, f.type});
+  append_slots(data, count, stride, slots_of(layout, slot_of_field), time_type(fields, layout), big_endian,
+               scan);
+}
+
+void append_columns(const unsigned char* columns, std::size_t count, const std::vector<CloudField>& fields,
+                    const PointLayout& layout, Scan& scan) {
+  std::vector<FieldSlot> slot_of_field;
+  std::size_t column_begin = 0;
+  for (const CloudField& f : fields) {
+    const std::size_t width = field_type_size(f.type) * f.count;
+    slot_of_field.push_back({column_begin, f.type, width});
+    column_begin += width * count;
   }
-  scan.has_ring = fr != nullptr;
-  scan.has_time = time_rule.valid;
+  append_slots(columns, count, 0, slots_of(layout, slot_of_field), time_type(fields, layout), false, scan);
+}
+
+void append_point_run(const unsigned char* data, std::size_t count, std::size_t stride,
+                      const PointSlots& slots, bool swap, const TimeRule& rule,
+                      std::vector<LidarPoint>& out) {
+  // Blocks small enough to stay in the L1 cache between the field passes and the assembly.
+  constexpr std::size_t kBlock = 256;
+  constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+  float xs[kBlock], ys[kBlock], zs[kBlock], intensity[kBlock], time[kBlock];
+  std::int16_t ring[kBlock];
+  // A coordinate beyond float's range (float64 fields) would become inf: dropped as non-finite.
+  auto coordinate = [](float* dst) {
+    return [dst](std::size_t i, double v) { dst[i] = fits_float(v) ? static_cast<float>(v) : kNaN; };
+  };
+  for (std::size_t begin = 0; begin < count; begin += kBlock) {
+    const std::size_t n = std::min(kBlock, count - begin);
+    for_each_value(data, begin, n, stride, slots.x, swap, coordinate(xs));
+    for_each_value(data, begin, n, stride, slots.y, swap, coordinate(ys));
+    for_each_value(data, begin, n, stride, slots.z, swap, coordinate(zs));
+    if (slots.intensity)
+      for_each_value(data, begin, n, stride, *slots.intensity, swap, [&](std::size_t i, double v) {
+        intensity[i] = fits_float(v) ? static_cast<float>(v) : 0.f;
+      });
+    if (slots.ring)
+      for_each_value(data, begin, n, stride, *slots.ring, swap,
+                     [&](std::size_t i, double v) { ring[i] = ring_from_value(v); });
+    if (slots.time && rule.valid)
+      for_each_value(data, begin, n, stride, *slots.time, swap, [&](std::size_t i, double v) {
+        const double t = v * rule.scale - rule.subtract_s;
+        time[i] = fits_float(t) ? static_cast<float>(t) : 0.f;
+      });
+    // Points written in place: a LidarPoint assembled on the stack and copied in stalls on
+    // store forwarding (its 16-byte copy reads five narrower stores), the most of the loop.
+    const std::size_t base = out.size();
+    out.resize(base + n);
+    LidarPoint* dst = out.data() + base;
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!std::isfinite(xs[i]) || !std::isfinite(ys[i]) || !std::isfinite(zs[i])) continue;
+      LidarPoint& q = dst[kept++];
+      q.x = xs[i];
+      q.y = ys[i];
+      q.z = zs[i];
+      q.intensity = slots.intensity ? intensity[i] : 0.f;
+      q.ring = slots.ring ? ring[i] : std::int16_t{-1};
+      q.time_s = slots.time && rule.valid ? time[i] : 0.f;
+    }
+    out.resize(base + kept);
+  }
+}
+
+void widen_field_range(const unsigned char* data, std::size_t count, std::size_t stride,
+                       FieldSlot slot, bool swap, double& lo, double& hi) {
+  // Locals, not the references: the field bytes may alias them, which would make the compiler
+  // store and reload both on every value.
+  double low = lo, high = hi;
+  for_each_value(data, 0, count, stride, slot, swap, [&](std::size_t, double v) {
+    if (!std::isfinite(v)) return;
+    low = std::min(low, v);
+    high = std::max(high, v);
+  });
+  lo = low;
+  hi = high;
+}
+
+bool host_is_big_endian() {
+  const std::uint16_t one = 1;
+  unsigned char first;
+  std::memcpy(&first, &one, 1);
+  return first == 0;
 }
 
 std::vector<std::string> describe_fields(const std::vector<CloudField>& fields) {

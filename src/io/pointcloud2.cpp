@@ -18,36 +18,10 @@ struct FieldReader {
   explicit operator bool() const { return field != nullptr; }
 };
 
-template <typename T>
-T load_swapped(const std::uint8_t* p, bool swap) {
-  std::uint8_t b[sizeof(T)];
-  std::memcpy(b, p, sizeof(T));
-  if (swap)
-    for (std::size_t i = 0; i < sizeof(T) / 2; ++i) std::swap(b[i], b[sizeof(T) - 1 - i]);
-  T v;
-  std::memcpy(&v, b, sizeof(T));
-  return v;
-}
-
-bool host_is_little_endian() {
-  const std::uint16_t one = 1;
-  std::uint8_t first;
-  std::memcpy(&first, &one, 1);
-  return first == 1;
-}
-
-double read_value(const std::uint8_t* p, std::uint8_t datatype, bool swap) {
-  switch (static_cast<PointFieldType>(datatype)) {
-    case PointFieldType::INT8: return static_cast<std::int8_t>(*p);
-    case PointFieldType::UINT8: return *p;
-    case PointFieldType::INT16: return load_swapped<std::int16_t>(p, swap);
-    case PointFieldType::UINT16: return load_swapped<std::uint16_t>(p, swap);
-    case PointFieldType::INT32: return load_swapped<std::int32_t>(p, swap);
-    case PointFieldType::UINT32: return load_swapped<std::uint32_t>(p, swap);
-    case PointFieldType::FLOAT32: return load_swapped<float>(p, swap);
-    case PointFieldType::FLOAT64: return load_swapped<double>(p, swap);
-  }
-  return std::numeric_limits<double>::quiet_NaN();
+// A field the conversion has checked (check_field: known datatype) as the shared readers'
+// slot; the PointField codes 1..8 are FieldType's order.
+FieldSlot slot_of(const PointField& f) {
+  return {f.offset, static_cast<FieldType>(f.datatype - 1)};
 }
 
 template <typename Names>
@@ -91,13 +65,7 @@ TimeRule pointcloud2_time_rule(const PointCloud2View& cloud, const PointField& f
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
   // width 0: no rows to walk (a fuzzed cloud of 0 x 4e9 points hung here).
   for (std::size_t r = 0; r < cloud.height && cloud.width > 0; ++r)
-    for (std::size_t c = 0; c < cloud.width; ++c) {
-      const double t = read_value(cloud.data + r * cloud.row_step + c * cloud.point_step + ft.offset,
-                                  ft.datatype, swap);
-      if (!std::isfinite(t)) continue;
-      lo = std::min(lo, t);
-      hi = std::max(hi, t);
-    }
+    widen_field_range(cloud.data + r * cloud.row_step, cloud.width, cloud.point_step, slot_of(ft), swap, lo, hi);
   return time_rule_for_range(lo, hi, is_integer_type(ft.datatype), cloud.stamp_s());
 }
 
@@ -170,38 +138,16 @@ Scan pointcloud2_to_scan(const PointCloud2View& cloud, const std::string& where)
   scan.timestamp_s = cloud.stamp_s();
   scan.has_ring = fr != nullptr;
   scan.points.reserve(width * height);
-  const bool swap = cloud.is_bigendian == host_is_little_endian();
+  const bool swap = cloud.is_bigendian != host_is_big_endian();
 
   const TimeRule time_rule = ft ? pointcloud2_time_rule(cloud, *ft, swap) : TimeRule{};
   scan.has_time = time_rule.valid;
   if (time_rule.sets_stamp) scan.timestamp_s = time_rule.subtract_s;  // stamp 0: the earliest point
 
-  for (std::size_t r = 0; r < height && width > 0; ++r) {  // width 0: no rows to walk
-    const std::uint8_t* row = cloud.data + r * row_step;
-    for (std::size_t c = 0; c < width; ++c) {
-      const std::uint8_t* p = row + c * point_step;
-      const double x = read_value(p + fx->offset, fx->datatype, swap);
-      const double y = read_value(p + fy->offset, fy->datatype, swap);
-      const double z = read_value(p + fz->offset, fz->datatype, swap);
-      // Finite as floats too: a FLOAT64 coordinate beyond 3.4e38 would become inf.
-      if (!fits_float(x) || !fits_float(y) || !fits_float(z)) continue;
-      LidarPoint pt;
-      pt.x = static_cast<float>(x);
-      pt.y = static_cast<float>(y);
-      pt.z = static_cast<float>(z);
-      if (fi) {
-        const double v = read_value(p + fi->offset, fi->datatype, swap);
-        pt.intensity = fits_float(v) ? static_cast<float>(v) : 0.f;  // as the PCD/PLY readers do
-      }
-      if (fr) pt.ring = ring_from_value(read_value(p + fr->offset, fr->datatype, swap));
-      if (time_rule.valid) {
-        const double t = read_value(p + ft->offset, ft->datatype, swap);
-        pt.time_s = static_cast<float>(t * time_rule.scale - time_rule.subtract_s);
-        if (!std::isfinite(pt.time_s)) pt.time_s = 0;
-      }
-      scan.points.push_back(pt);
-    }
-  }
+  auto slot = [](const PointField* f) { return f ? std::optional<FieldSlot>(slot_of(*f)) : std::nullopt; };
+  const PointSlots slots{slot_of(*fx), slot_of(*fy), slot_of(*fz), slot(fi), slot(fr), slot(ft)};
+  for (std::size_t r = 0; r < height && width > 0; ++r)  // width 0: no rows to walk
+    append_point_run(cloud.data + r * row_step, width, point_step, slots, swap, time_rule, scan.points);
   return scan;
 }
 

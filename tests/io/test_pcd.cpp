@@ -2,6 +2,7 @@
 // another library (Open3D), and truncated/corrupt files.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -248,6 +249,68 @@ TEST(Pcd, UnusualLayoutFieldOrderPaddingFloat64Uint8CountAndNaN) {
   write_bytes(odd, "VERSION 0.7\nFIELDS x y z time\nSIZE 4 4 4 4\nTYPE F F F F\nWIDTH 2\nHEIGHT 1\n"
                    "POINTS 2\nDATA ascii\n1 2 3 5\n4 5 6 5e9\n");
   EXPECT_FALSE(read_pcd(odd).scan.has_time);  // 5 .. 5e9: no reading (s or ns) fits one sweep
+}
+
+// binary_compressed is the binary layout's fields one after another (struct of arrays): read
+// from those columns directly, it must give the binary file's scan for any layout, with NaN
+// points dropped wherever they fall relative to the reader's blocks of 256 points.
+TEST(Pcd, BinaryCompressedReadsAsBinaryForAnyLayoutAndAcrossBlocks) {
+  const fs::path dir = test::scratch_dir("pcd_columns");
+  // uint8 intensity, 3 padding bytes, float32 z, float64 x and y, a normal of COUNT 3, uint16
+  // ring, uint32 nanosecond time: 1000 points, NaN x at block edges.
+  const std::vector<std::size_t> widths = {1, 3, 4, 8, 8, 12, 2, 4};
+  const std::size_t step = 42, n = 1000;
+  const std::vector<std::size_t> nan_at = {0, 255, 256, 257, 511, 512, 999};
+  std::string rows;
+  for (std::size_t i = 0; i < n; ++i) {
+    const bool nan = std::find(nan_at.begin(), nan_at.end(), i) != nan_at.end();
+    append<std::uint8_t>(rows, static_cast<std::uint8_t>(i % 251));
+    rows.append(3, '\0');
+    append<float>(rows, 0.25f * static_cast<float>(i % 40));
+    append<double>(rows, nan ? std::nan("") : 0.5 * static_cast<double>(i));
+    append<double>(rows, -1.0 * static_cast<double>(i));
+    for (int k = 0; k < 3; ++k) append<float>(rows, 9.f);
+    append<std::uint16_t>(rows, static_cast<std::uint16_t>(i % 64));
+    append<std::uint32_t>(rows, static_cast<std::uint32_t>(100000 * i));
+  }
+  ASSERT_EQ(rows.size(), n * step);
+  std::string columns;
+  std::size_t offset = 0;
+  for (std::size_t w : widths) {
+    for (std::size_t i = 0; i < n; ++i) columns.append(rows, i * step + offset, w);
+    offset += w;
+  }
+  const std::string header =
+      "VERSION 0.7\nFIELDS intensity _ z x y normal ring t\nSIZE 1 1 4 8 8 4 2 4\nTYPE U U F F F F U U\n"
+      "COUNT 1 3 1 1 1 3 1 1\nWIDTH 1000\nHEIGHT 1\nPOINTS 1000\n";
+  write_bytes(dir / "rows.pcd", header + "DATA binary\n" + rows);
+  const auto packed = lzf_compress(reinterpret_cast<const unsigned char*>(columns.data()), columns.size());
+  std::string compressed = header + "DATA binary_compressed\n";
+  append<std::uint32_t>(compressed, static_cast<std::uint32_t>(packed.size()));
+  append<std::uint32_t>(compressed, static_cast<std::uint32_t>(columns.size()));
+  compressed.append(reinterpret_cast<const char*>(packed.data()), packed.size());
+  write_bytes(dir / "columns.pcd", compressed);
+
+  const Scan a = read_pcd(dir / "rows.pcd").scan;
+  const Scan b = read_pcd(dir / "columns.pcd").scan;
+  ASSERT_EQ(a.points.size(), n - nan_at.size());
+  ASSERT_EQ(b.points.size(), a.points.size());
+  EXPECT_TRUE(a.has_ring && b.has_ring && a.has_time && b.has_time);
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (std::find(nan_at.begin(), nan_at.end(), i) != nan_at.end()) continue;
+    for (const Scan* s : {&a, &b}) {
+      SCOPED_TRACE(s == &a ? "DATA binary" : "DATA binary_compressed");
+      const LidarPoint& p = s->points[k];
+      ASSERT_EQ(p.x, 0.5f * static_cast<float>(i)) << i;
+      ASSERT_EQ(p.y, -static_cast<float>(i)) << i;
+      ASSERT_EQ(p.z, 0.25f * static_cast<float>(i % 40)) << i;
+      ASSERT_EQ(p.intensity, static_cast<float>(i % 251)) << i;
+      ASSERT_EQ(p.ring, static_cast<std::int16_t>(i % 64)) << i;
+      ASSERT_NEAR(p.time_s, 1e-4 * static_cast<double>(i), 1e-7) << i;  // nanoseconds
+    }
+    ++k;
+  }
 }
 
 TEST(Pcd, ReadsFilesWrittenByOpen3D) {

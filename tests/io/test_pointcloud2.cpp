@@ -99,6 +99,18 @@ TEST(PointCloud2, OrganizedCloudDropsNaNs) {
   expect_points(round_trip(pts, 0.0, L, false), pts, L, 1e-7);
 }
 
+// Rows longer than the conversion's blocks of 256 points, in big-endian float64, each row a
+// run of its own (row_step), with the NaN slots of the last row dropped.
+TEST(PointCloud2, OrganizedRowsLongerThanTheConversionsBlocks) {
+  const auto pts = sample_points(1000);  // 3 rows of 334: 2 NaN slots at the end
+  test::CloudLayout L;
+  L.height = 3;
+  L.xyz_type = 8;
+  L.big_endian = true;
+  L.padding = 3;
+  expect_points(round_trip(pts, 5.0, L, true), pts, L, 1e-7);
+}
+
 TEST(PointCloud2, TimeFieldConventions) {
   const auto pts = sample_points(30);
   test::CloudLayout L;
