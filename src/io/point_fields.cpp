@@ -35,6 +35,7 @@ T load(const unsigned char* p) {
 template <typename Sink>
 void for_each_value(const unsigned char* data, std::size_t first, std::size_t count, std::size_t stride,
                     FieldSlot slot, bool swap, Sink&& sink) {
+  if (count == 0) return;  // `data` may be null then (an empty cloud's buffer)
   if (slot.stride != 0) stride = slot.stride;
   auto run = [&](auto value_type, auto swapped) {
     using T = decltype(value_type);
