@@ -40,6 +40,11 @@ class RunOutputs : public ::testing::Test {
       write_pcd(root_ / "pcd" / ("scan" + std::to_string(i) + ".pcd"), seq.load(i).points,
                 PcdEncoding::kBinaryCompressed);
     fs::copy_file(root_ / "kitti" / "times.txt", root_ / "stamps.txt");
+    // Three of them with ring and time fields, as a raw driver's scans come.
+    fs::create_directories(root_ / "pcd_time");
+    for (std::size_t i = 0; i < 3; ++i)
+      write_pcd(root_ / "pcd_time" / ("scan" + std::to_string(i) + ".pcd"), seq.load(i).points,
+                PcdEncoding::kBinary, /*with_ring_time=*/true);
   }
   static fs::path root_;
 };
@@ -150,6 +155,18 @@ TEST_F(RunOutputs, SensorPresetsLoadAndLivoxSaysWhyNot) {
     EXPECT_EQ(k.output.find("--sensor kitti corrects") != std::string::npos, std::string(sensor) == "hdl64")
         << sensor << ": " << k.output;
   }
+  // Scans with per-point times run without deskew (KITTI's preset) are told about it; with a
+  // raw-driver preset, or without times, they are not.
+  const std::string deskew_note = "per-point times but deskew is off";
+  for (const char* preset : {"", "kitti", "hdl64"}) {
+    const std::string sensor = *preset ? std::string(" --sensor ") + preset : "";
+    const Outcome t = run_cli("run " + (root_ / "pcd_time").string() + " -o " + (root_ / "preset" / "t").string() +
+                              " --mode odometry --quiet -f -n 2" + sensor);
+    EXPECT_EQ(t.exit_code, 0) << t.output;
+    EXPECT_EQ(t.output.find(deskew_note) != std::string::npos, std::string(preset) != "hdl64")
+        << preset << ": " << t.output;
+  }
+  EXPECT_EQ(plain.output.find(deskew_note), std::string::npos) << plain.output;
   Outcome r = run_cli("run " + (root_ / "pcd").string() + " -o " + (root_ / "lv").string() + " --sensor livox");
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.output.find("ring"), std::string::npos) << r.output;
