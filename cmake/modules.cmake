@@ -1,14 +1,23 @@
-# scfloam_module(<room> DEPS ...): a static library scfloam_<room> from src/<room>/*.cpp.
-# Rooms with no sources yet become interface libraries so that dependents still configure.
+include(${CMAKE_CURRENT_LIST_DIR}/precompiled_headers.cmake)
+
+# scfloam_module(<room> DEPS ... [PCH_GROUP name]): a static library scfloam_<room> from
+# src/<room>/*.cpp. Rooms with no sources yet become interface libraries so that dependents
+# still configure. PCH_GROUP (default `libraries`): rooms whose dependencies add compile
+# definitions share a precompiled header of their own (Open3D defines _GLIBCXX_USE_CXX11_ABI,
+# and a header precompiled without it is not used).
 set(SCFLOAM_MODULES "" CACHE INTERNAL "")
 function(scfloam_module room)
-  cmake_parse_arguments(M "" "" "DEPS" ${ARGN})
+  cmake_parse_arguments(M "" "PCH_GROUP" "DEPS" ${ARGN})
+  if(NOT M_PCH_GROUP)
+    set(M_PCH_GROUP libraries)
+  endif()
   file(GLOB sources CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/src/${room}/*.cpp)
   set(target scfloam_${room})
   if(sources)
     add_library(${target} STATIC ${sources})
     target_include_directories(${target} PUBLIC ${CMAKE_SOURCE_DIR}/include PRIVATE ${CMAKE_SOURCE_DIR}/src)
     target_link_libraries(${target} PUBLIC ${M_DEPS})
+    scfloam_precompile(${target} GROUP ${M_PCH_GROUP})
   else()
     add_library(${target} INTERFACE)
     target_include_directories(${target} INTERFACE ${CMAKE_SOURCE_DIR}/include)
@@ -34,6 +43,7 @@ function(scfloam_test_suite room)
   add_executable(test_${room} ${sources} ${CMAKE_SOURCE_DIR}/tests/support/tbb_threads.cpp)
   target_link_libraries(test_${room} PRIVATE ${T_LIBS} GTest::gtest GTest::gtest_main)
   target_include_directories(test_${room} PRIVATE ${CMAKE_SOURCE_DIR}/src ${CMAKE_SOURCE_DIR}/tests)
+  scfloam_precompile(test_${room} GROUP tests HEADERS <gtest/gtest.h>)
   target_compile_definitions(test_${room} PRIVATE
     SCFLOAM_SHARED_DIR="${SCFLOAM_SHARED_DIR}"
     SCFLOAM_BINARY_DIR="${CMAKE_BINARY_DIR}")
