@@ -18,7 +18,7 @@ bin=build/bin
 shared="${SCFLOAM_SHARED_DIR:-$(cd .. && pwd)/shared}"
 
 echo "== micro-benchmarks"
-for b in bench_odometry bench_loop bench_pose_graph; do
+for b in bench_odometry bench_loop bench_pose_graph bench_readers; do
   SCFLOAM_SHARED_DIR="$shared" "$bin/$b" --benchmark_repetitions="$repeat" \
     --benchmark_report_aggregates_only=true --benchmark_format=json > "$results/$b.json"
 done
