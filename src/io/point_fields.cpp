@@ -173,13 +173,13 @@ namespace {
 
 // append_points and append_columns once each field has its slot.
 void append_slots(const unsigned char* data, std::size_t count, std::size_t stride, const PointSlots& slots,
-                  std::optional<FieldType> time_type, bool big_endian, Scan& scan) {
+                  bool big_endian, Scan& scan) {
   const bool swap = big_endian != host_is_big_endian();
   TimeRule time_rule;
   if (slots.time) {
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
     widen_field_range(data, count, stride, *slots.time, swap, lo, hi);
-    time_rule = time_rule_for_range(lo, hi, is_integer(*time_type), scan.timestamp_s);
+    time_rule = time_rule_for_range(lo, hi, is_integer(slots.time->type), scan.timestamp_s);
   }
   if (time_rule.sets_stamp) scan.timestamp_s = time_rule.subtract_s;
   scan.points.reserve(scan.points.size() + count);
@@ -197,11 +197,6 @@ PointSlots slots_of(const PointLayout& layout, const std::vector<FieldSlot>& slo
           slot(layout.time)};
 }
 
-std::optional<FieldType> time_type(const std::vector<CloudField>& fields, const PointLayout& layout) {
-  if (layout.time < 0) return std::nullopt;
-  return fields.at(static_cast<std::size_t>(layout.time)).type;
-}
-
 }  // namespace
 
 void append_points(const unsigned char* data, std::size_t count, std::size_t stride,
@@ -209,8 +204,7 @@ void append_points(const unsigned char* data, std::size_t count, std::size_t str
                    bool big_endian, Scan& scan) {
   std::vector<FieldSlot> slot_of_field;
   for (const CloudField& f : fields) slot_of_field.push_back({f.offset, f.type});
-  append_slots(data, count, stride, slots_of(layout, slot_of_field), time_type(fields, layout), big_endian,
-               scan);
+  append_slots(data, count, stride, slots_of(layout, slot_of_field), big_endian, scan);
 }
 
 void append_columns(const unsigned char* columns, std::size_t count, const std::vector<CloudField>& fields,
@@ -222,7 +216,7 @@ void append_columns(const unsigned char* columns, std::size_t count, const std::
     slot_of_field.push_back({column_begin, f.type, width});
     column_begin += width * count;
   }
-  append_slots(columns, count, 0, slots_of(layout, slot_of_field), time_type(fields, layout), false, scan);
+  append_slots(columns, count, 0, slots_of(layout, slot_of_field), false, scan);
 }
 
 void append_point_run(const unsigned char* data, std::size_t count, std::size_t stride,

@@ -1,9 +1,8 @@
 #include "scfloam/io/pointcloud2.hpp"
 
 #include <array>
-#include <cmath>
-#include <cstring>
 #include <limits>
+#include <optional>
 
 #include "scfloam/error.hpp"
 #include "scfloam/io/field_names.hpp"
@@ -11,12 +10,6 @@
 
 namespace scfloam {
 namespace {
-
-// One field the Scan needs, resolved once per cloud.
-struct FieldReader {
-  const PointField* field = nullptr;
-  explicit operator bool() const { return field != nullptr; }
-};
 
 // A field the conversion has checked (check_field: known datatype) as the shared readers'
 // slot; the PointField codes 1..8 are FieldType's order.
