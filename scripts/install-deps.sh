@@ -6,7 +6,7 @@ packages=(
   build-essential cmake git pkg-config
   libeigen3-dev libceres-dev libnanoflann-dev libtbb-dev libyaml-cpp-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev libpng-dev zlib1g-dev nlohmann-json3-dev
-  libsqlite3-dev libzstd-dev liblz4-dev libbz2-dev
+  libsqlite3-dev libzstd-dev liblz4-dev libbz2-dev liblzf-dev
   librosbag-dev libsensor-msgs-dev  # ROS 1 bags (reader; sensor_msgs only for the writer in tests)
   libopen3d-dev
   clang libclang-rt-14-dev

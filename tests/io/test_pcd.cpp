@@ -79,6 +79,32 @@ TEST(Lzf, RoundTripOfRepetitiveAndRandomData) {
   EXPECT_FALSE(lzf_decompress(packed.data(), packed.size(), data.size() + 1));  // wrong size
   std::vector<unsigned char> bad = {0xe0, 0x10, 0xff};  // reference before the start
   EXPECT_FALSE(lzf_decompress(bad.data(), bad.size(), 20));
+  EXPECT_FALSE(lzf_decompress(packed.data(), packed.size() - 1, data.size()));  // truncated
+}
+
+TEST(Lzf, IncompressibleRunsAndEmptyInputsRoundTrip) {
+  std::vector<unsigned char> noise(1 << 20);
+  std::mt19937 rng(5);
+  for (auto& b : noise) b = rng() & 0xff;
+  const auto packed_noise = lzf_compress(noise.data(), noise.size());  // grows, must still fit
+  const auto noise_back = lzf_decompress(packed_noise.data(), packed_noise.size(), noise.size());
+  ASSERT_TRUE(noise_back);
+  EXPECT_EQ(*noise_back, noise);
+
+  const std::vector<unsigned char> zeros(1 << 20, 0);
+  const auto packed_zeros = lzf_compress(zeros.data(), zeros.size());
+  EXPECT_LT(packed_zeros.size(), zeros.size() / 50);
+  const auto zeros_back = lzf_decompress(packed_zeros.data(), packed_zeros.size(), zeros.size());
+  ASSERT_TRUE(zeros_back);
+  EXPECT_EQ(*zeros_back, zeros);
+  // A size no LZF stream of this length can reach (over 88 bytes out per byte in) is refused
+  // before anything that large is allocated.
+  EXPECT_FALSE(lzf_decompress(packed_zeros.data(), 10, std::size_t{1} << 31));
+
+  EXPECT_TRUE(lzf_compress(nullptr, 0).empty());
+  const auto empty = lzf_decompress(nullptr, 0, 0);
+  ASSERT_TRUE(empty);
+  EXPECT_TRUE(empty->empty());
 }
 
 TEST(Pcd, RoundTripOfEveryEncodingWithAndWithoutRingAndTime) {

@@ -1,5 +1,5 @@
-// LZF, the compression of PCD's `DATA binary_compressed` (liblzf's format: literal runs of up
-// to 32 bytes and back references of up to 264 bytes within 8 KiB).
+// LZF, the compression of PCD's `DATA binary_compressed`, done by Debian's liblzf
+// (src/io/pcd_lzf.cpp adapts its 32-bit C interface).
 #pragma once
 
 #include <cstddef>
@@ -8,6 +8,7 @@
 
 namespace scfloam {
 
+// Throws std::length_error over 4 GiB (PCD stores the sizes in 32 bits).
 std::vector<unsigned char> lzf_compress(const unsigned char* data, std::size_t size);
 // nullopt when the stream is corrupt or does not decode to exactly `expected_size` bytes.
 std::optional<std::vector<unsigned char>> lzf_decompress(const unsigned char* data, std::size_t size,
