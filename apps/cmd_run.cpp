@@ -11,6 +11,7 @@
 #include "interrupt.hpp"
 #include "scfloam/error.hpp"
 #include "scfloam/io/scan_source.hpp"
+#include "scfloam/io/sensor_detection.hpp"
 #include "scfloam/pipeline/outputs.hpp"
 #include "scfloam/pipeline/pipeline.hpp"
 
@@ -117,10 +118,12 @@ void overlay(YAML::Node base, const YAML::Node& top) {
   }
 }
 
-// --sensor picks a preset; --config on top of it overrides the keys it sets.
-SlamConfig load_run_config(const RunArgs& args) {
-  if (args.sensor.empty()) return args.config_file.empty() ? SlamConfig{} : load_config(args.config_file);
-  const SlamConfig preset = load_config(preset_path(args.sensor));
+// `sensor` (given or guessed) picks a preset; --config on top of it overrides the keys it sets.
+// "kitti" is the built-in defaults and needs no file.
+SlamConfig load_run_config(const RunArgs& args, const std::string& sensor) {
+  if (sensor == "kitti" && args.sensor.empty())
+    return args.config_file.empty() ? SlamConfig{} : load_config(args.config_file);
+  const SlamConfig preset = load_config(preset_path(sensor));
   if (args.config_file.empty()) return preset;
   load_config(args.config_file);  // its own errors name the user's file
   YAML::Node merged = YAML::Load(config_to_yaml(preset));
@@ -140,11 +143,22 @@ void run(const RunArgs& args) {
   if (!mode) throw Error("--mode: unknown mode '" + args.mode + "' (odometry, simple-sc, optimized)");
   const auto frame = parse_pose_frame(args.frame);
   if (!frame) throw Error("--frame: unknown frame '" + args.frame + "' (lidar, camera, auto)");
-  const SlamConfig config = load_run_config(args);
+  if (!args.sensor.empty()) preset_path(args.sensor);  // an unknown --sensor fails before any input is read
   ScanSourceOptions source_options;
   source_options.topic = args.topic;
   source_options.timestamps_file = args.timestamps;
   const auto source = open_scan_source(args.input, source_options);
+  // Without --sensor the scans' beams choose the preset: KITTI's settings (0.22 deg of beam
+  // correction, its leaf sizes, no deskew) on a VLP-16 cost 19x in drift (docs/inputs.md).
+  SensorGuess guess;
+  if (args.sensor.empty()) {
+    guess = guess_sensor(*source);
+    if (!args.quiet)
+      std::fprintf(stderr, "sensor: %s, from the scans (%s); --sensor chooses another\n", guess.preset.c_str(),
+                   guess.reason.c_str());
+  }
+  const std::string sensor = args.sensor.empty() ? guess.preset : args.sensor;
+  const SlamConfig config = load_run_config(args, sensor);
   OutputOptions outputs;
   outputs.map_voxel_m = args.map_voxel_m;
   outputs.write_ply = args.ply;
@@ -164,7 +178,7 @@ void run(const RunArgs& args) {
     std::fprintf(stderr,
                  "note: an HDL-64E without elevation correction on a KITTI sequence: KITTI's own scans read "
                  "~0.22 deg low (a steady pitch drift); --sensor kitti corrects that\n");
-  if (args.sensor.empty() && args.config_file.empty() && !kitti_input)
+  if (args.sensor.empty() && guess.preset == "kitti" && args.config_file.empty() && !kitti_input)
     // The defaults carry KITTI's own calibration error: on another HDL-64E it costs 13x in
     // drift (docs/odometry.md, "Session 19"). A ring table that does not fit the sensor is
     // replaced by beams learned from the scans, but the leaf sizes and deskew stay KITTI's.
@@ -188,6 +202,8 @@ void run(const RunArgs& args) {
   options.stop = &install_interrupt_handlers();
   const RunResult result = run_slam(*source, config, options);
   nlohmann::json summary = make_summary(*source, result);
+  summary["sensor"] = {{"preset", sensor}, {"from", args.sensor.empty() ? "scans" : "--sensor"}};
+  if (args.sensor.empty()) summary["sensor"]["reason"] = guess.reason;
   summary["interrupted"] = result.interrupted;
   write_run_outputs(out_dir, *source, result, summary, outputs);
   print_report(summary);
@@ -214,7 +230,7 @@ RegisterCommand reg("run", [](CLI::App& app) {
   sub->add_option("-s,--sensor", args->sensor,
                   "Sensor preset: kitti (the defaults: KITTI's HDL-64E scans) | hdl64 | hdl32 | vlp16 | os1-64 | "
                   "os1-128 | auto (another spinning sensor: beams learned from the scans) (config/); --config "
-                  "overrides its keys");
+                  "overrides its keys. Default: chosen from the scans' beams (kitti for an HDL-64E)");
   sub->add_option("--topic", args->topic, "Bags: the PointCloud2 topic (auto when there is only one)");
   sub->add_option("--timestamps", args->timestamps, "Folders: file with one stamp (s) per scan, in scan order");
   sub->add_option("--frame", args->frame, "KITTI trajectories in lidar | camera | auto (camera when the input has Tr)");

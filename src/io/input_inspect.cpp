@@ -10,6 +10,7 @@
 #include "scfloam/io/kitti.hpp"
 #include "scfloam/io/point_cloud_file.hpp"
 #include "scfloam/io/scan_source.hpp"
+#include "scfloam/io/sensor_detection.hpp"
 
 namespace scfloam {
 namespace fs = std::filesystem;
@@ -68,14 +69,10 @@ void describe_beams(const Scan& first, InputInfo& info) {
   } else {
     // A preset fits when its table keeps every beam in a ring of its own (KITTI's HDL-64E
     // table may crop the lowest beams or the top one at its edge: up to 3 of 64).
+    // (io/sensor_detection.hpp)
     std::string fitting;
-    for (LidarModel m : {LidarModel::hdl64, LidarModel::hdl32, LidarModel::vlp16, LidarModel::os1_64,
-                         LidarModel::os1_128}) {
-      const TableFit fit = check_table_fit(m, layout);
-      if (static_cast<int>(layout.elevations_deg.size()) == num_beams(m) && fit.fits &&
-          fit.dropped_beams * 20 <= num_beams(m))
-        fitting += std::string(fitting.empty() ? "" : ", ") + lidar_model_name(m);
-    }
+    for (LidarModel m : matching_ring_tables(layout))
+      fitting += std::string(fitting.empty() ? "" : ", ") + lidar_model_name(m);
     std::snprintf(line, sizeof line,
                   "beams: %zu distinct elevations, %+.2f .. %+.2f deg (%.1f %% of returns on them); %s",
                   layout.elevations_deg.size(), layout.elevations_deg.front(), layout.elevations_deg.back(),
@@ -99,7 +96,11 @@ InputInfo inspect_input(const fs::path& path, const ScanSourceOptions& options) 
   }
   if (info.scans > 0) {
     const auto source = open_scan_source(path, options);
-    if (source->size() > 0) describe_beams(source->load(0), info);
+    if (source->size() > 0) {
+      describe_beams(source->load(0), info);
+      const SensorGuess guess = guess_sensor(*source);
+      info.notes.push_back("sensor: `scfloam run` without --sensor uses " + guess.preset + " (" + guess.reason + ")");
+    }
   }
   return info;
 }

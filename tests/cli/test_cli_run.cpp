@@ -92,8 +92,9 @@ TEST(CliRun, RingsOfAnotherSensorAreLearnedOrTheCropIsReported) {
   EXPECT_EQ(rings["source"], "learned");
   EXPECT_EQ(rings["beams"], 32);
 
-  // The defaults' HDL-64E table on a VLP-16: no two beams share a ring, seven are above +2 deg.
-  r = run_cli("run " + (dir / "v16").string() + " -m odometry -q -o " + (dir / "o16").string());
+  // KITTI's HDL-64E table on a VLP-16 (--sensor kitti; without --sensor the scans choose
+  // vlp16): no two beams share a ring, seven are above +2 deg.
+  r = run_cli("run " + (dir / "v16").string() + " --sensor kitti -m odometry -q -o " + (dir / "o16").string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("leaves out 7 of the scans' 16 beams"), std::string::npos) << r.output;
   rings = read_json(dir / "o16" / "summary.json")["rings"];
