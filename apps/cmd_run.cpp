@@ -118,6 +118,15 @@ void overlay(YAML::Node base, const YAML::Node& top) {
   }
 }
 
+// Whether a YAML document sets the key at this path (maps all the way down).
+bool yaml_has(YAML::Node node, std::initializer_list<const char*> path) {
+  for (const char* key : path) {
+    if (!node.IsMap() || !node[key]) return false;
+    node.reset(node[key]);  // rebinds (operator= would write into the document)
+  }
+  return true;
+}
+
 // `sensor` (given or guessed) picks a preset; --config on top of it overrides the keys it sets.
 // "kitti" is the built-in defaults and needs no file.
 SlamConfig load_run_config(const RunArgs& args, const std::string& sensor) {
@@ -158,7 +167,19 @@ void run(const RunArgs& args) {
                    guess.reason.c_str());
   }
   const std::string sensor = args.sensor.empty() ? guess.preset : args.sensor;
-  const SlamConfig config = load_run_config(args, sensor);
+  SlamConfig config = load_run_config(args, sensor);
+  // Per-point times mean a raw driver's, motion-distorted scans, which the presets of raw
+  // sensors deskew; a guessed HDL-64E (KITTI's preset: its scans are compensated) is deskewed
+  // too, unless --config says otherwise: on a motion-distorted HDL-64E world that is 0.70 %
+  // drift against 0.063 % (docs/inputs.md).
+  const bool per_point_times = source->size() > 0 && source->load(0).has_time;
+  const bool config_sets_deskew = !args.config_file.empty() && yaml_has(YAML::LoadFile(args.config_file),
+                                                                         {"odometry", "preprocess", "deskew"});
+  if (args.sensor.empty() && per_point_times && !config.odometry.preprocess.deskew && !config_sets_deskew) {
+    config.odometry.preprocess.deskew = true;
+    guess.reason += "; deskew on: the scans carry per-point times";
+    if (!args.quiet) std::fprintf(stderr, "sensor: deskew on, the scans carry per-point times\n");
+  }
   OutputOptions outputs;
   outputs.map_voxel_m = args.map_voxel_m;
   outputs.write_ply = args.ply;
@@ -186,9 +207,7 @@ void run(const RunArgs& args) {
                  "note: no --sensor or --config: using the defaults, made for KITTI's HDL-64E scans (beams "
                  "raised 0.22 deg, no deskew); for your sensor pass --sensor hdl64 | hdl32 | vlp16 | os1-64 | "
                  "os1-128, or auto for another spinning sensor\n");
-  // Per-point times mean a raw driver's scans, which KITTI's preset would not deskew: on a
-  // motion-distorted HDL-64E world that is 0.70 % drift against 0.063 % (docs/inputs.md).
-  if (!config.odometry.preprocess.deskew && source->size() > 0 && source->load(0).has_time)
+  if (!config.odometry.preprocess.deskew && per_point_times)
     std::fprintf(stderr,
                  "note: the scans carry per-point times but deskew is off (KITTI's preset: its scans are "
                  "motion-compensated); for raw scans pass --sensor for your sensor, or set "
@@ -202,7 +221,9 @@ void run(const RunArgs& args) {
   options.stop = &install_interrupt_handlers();
   const RunResult result = run_slam(*source, config, options);
   nlohmann::json summary = make_summary(*source, result);
-  summary["sensor"] = {{"preset", sensor}, {"from", args.sensor.empty() ? "scans" : "--sensor"}};
+  summary["sensor"] = {{"preset", sensor},
+                       {"from", args.sensor.empty() ? "scans" : "--sensor"},
+                       {"deskew", config.odometry.preprocess.deskew}};
   if (args.sensor.empty()) summary["sensor"]["reason"] = guess.reason;
   summary["interrupted"] = result.interrupted;
   write_run_outputs(out_dir, *source, result, summary, outputs);

@@ -155,16 +155,22 @@ TEST_F(RunOutputs, SensorPresetsLoadAndLivoxSaysWhyNot) {
     EXPECT_EQ(k.output.find("--sensor kitti corrects") != std::string::npos, std::string(sensor) == "hdl64")
         << sensor << ": " << k.output;
   }
-  // Scans with per-point times run without deskew (KITTI's preset) are told about it; with a
-  // raw-driver preset, or without times, they are not.
+  // Scans with per-point times run without deskew (KITTI's preset given) are told about it;
+  // with a raw-driver preset, or without times, they are not. Without --sensor the guessed
+  // HDL-64E is deskewed (a raw driver's scans), unless --config turns deskew off.
   const std::string deskew_note = "per-point times but deskew is off";
-  for (const char* preset : {"", "kitti", "hdl64"}) {
-    const std::string sensor = *preset ? std::string(" --sensor ") + preset : "";
-    const Outcome t = run_cli("run " + (root_ / "pcd_time").string() + " -o " + (root_ / "preset" / "t").string() +
-                              " --mode odometry --quiet -f -n 2" + sensor);
-    EXPECT_EQ(t.exit_code, 0) << t.output;
-    EXPECT_EQ(t.output.find(deskew_note) != std::string::npos, std::string(preset) != "hdl64")
-        << preset << ": " << t.output;
+  { std::ofstream(root_ / "no_deskew.yaml") << "odometry:\n  preprocess:\n    deskew: false\n"; }
+  const std::string no_deskew = " --config " + (root_ / "no_deskew.yaml").string();
+  for (const std::string extra : {"", " --sensor kitti", " --sensor hdl64", no_deskew.c_str()}) {
+    const fs::path out = root_ / "preset" / "t";
+    const Outcome t = run_cli("run " + (root_ / "pcd_time").string() + " -o " + out.string() +
+                              " --mode odometry --quiet -f -n 2" + extra);
+    ASSERT_EQ(t.exit_code, 0) << t.output;
+    const bool deskew_off = extra == " --sensor kitti" || extra == no_deskew;
+    EXPECT_EQ(t.output.find(deskew_note) != std::string::npos, deskew_off) << extra << ": " << t.output;
+    const auto summary = nlohmann::json::parse(std::ifstream(out / "summary.json"));
+    EXPECT_EQ(summary["sensor"]["deskew"].get<bool>(), !deskew_off) << extra;
+    EXPECT_EQ(summary["sensor"]["from"], extra.find("--sensor") == std::string::npos ? "scans" : "--sensor") << extra;
   }
   EXPECT_EQ(plain.output.find(deskew_note), std::string::npos) << plain.output;
   Outcome r = run_cli("run " + (root_ / "pcd").string() + " -o " + (root_ / "lv").string() + " --sensor livox");
