@@ -1,5 +1,6 @@
 #include "scfloam/io/sensor_detection.hpp"
 
+#include <cmath>
 #include <cstdio>
 
 namespace scfloam {
@@ -19,6 +20,26 @@ const char* preset_of(LidarModel model) {
   return "auto";
 }
 
+// A uniform fan's beams seen only in part: every learned beam within a fifth of the spacing
+// of one of the fan's beams, the learned ones consecutive (what is missing is at the top or the
+// bottom: open sky, the car's own body), at least half of them. A sensor with every other
+// beam of a fan (an OS1-32 against the OS1-64's fan) is not consecutive and does not match.
+bool is_end_cut_of_fan(LidarModel model, const std::vector<double>& elevations_deg) {
+  if (model == LidarModel::hdl64) return false;  // two blocks, not a uniform fan
+  const BeamFan f = beam_fan(model);
+  const double spacing = (f.highest_deg - f.lowest_deg) / (f.beams - 1);
+  if (static_cast<int>(elevations_deg.size()) * 2 < f.beams) return false;
+  long previous = -1;
+  for (double e : elevations_deg) {  // highest first
+    const double pos = (f.highest_deg - e) / spacing;
+    const long index = std::lround(pos);
+    if (std::abs(pos - static_cast<double>(index)) > 0.2 || index < 0 || index >= f.beams) return false;
+    if (previous >= 0 && index != previous + 1) return false;
+    previous = index;
+  }
+  return true;
+}
+
 }  // namespace
 
 std::vector<LidarModel> matching_ring_tables(const BeamLayout& layout) {
@@ -28,10 +49,12 @@ std::vector<LidarModel> matching_ring_tables(const BeamLayout& layout) {
   for (LidarModel m : {LidarModel::hdl64, LidarModel::hdl32, LidarModel::vlp16, LidarModel::os1_64,
                        LidarModel::os1_128}) {
     const int n = num_beams(m);
-    // Up to 1 in 8 of the beams may be missing (a sparse sensor's upward beams under open sky).
-    if (beams > n || beams * 8 < n * 7) continue;
+    if (beams > n) continue;
+    // Nearly all beams (up to 1 in 8 missing) in rings of their own, or a fan cut at its ends.
     const TableFit fit = check_table_fit(m, layout);
-    if (fit.fits && fit.dropped_beams * 20 <= n) out.push_back(m);
+    if ((beams * 8 >= n * 7 && fit.fits && fit.dropped_beams * 20 <= n) ||
+        is_end_cut_of_fan(m, layout.elevations_deg))
+      out.push_back(m);
   }
   return out;
 }

@@ -54,8 +54,8 @@ TEST(SensorDetection, EachSimulatedSensorGetsItsOwnPreset) {
   }
 }
 
-TEST(SensorDetection, ABeamOrTwoUnderOpenSkyStillMatchesButHalfTheBeamsDoNot) {
-  // Only a table's own beams can match it: drop the returns of the top beams (open sky).
+TEST(SensorDetection, TopBeamsUnderOpenSkyStillMatchTheirFanButEveryOtherBeamDoesNot) {
+  // Drop the returns of the top beams, as under open sky: the rest is still the sensor's fan.
   const sim::World world = courtyard();
   std::vector<LidarPoint> vlp16 = scan_of(world, "vlp16");
   auto without_above = [](std::vector<LidarPoint> pts, double elevation_deg) {
@@ -67,8 +67,18 @@ TEST(SensorDetection, ABeamOrTwoUnderOpenSkyStillMatchesButHalfTheBeamsDoNot) {
     return pts;
   };
   EXPECT_EQ(guess_sensor(without_above(vlp16, 14.0)).preset, "vlp16");  // 15 of 16 beams
-  // 8 of 16: a different sensor as far as anyone can tell; its learned beams are used.
-  EXPECT_EQ(guess_sensor(without_above(vlp16, 0.0)).preset, "auto");
+  EXPECT_EQ(guess_sensor(without_above(vlp16, 6.0)).preset, "vlp16");   // 11: the fan's lower beams
+  EXPECT_EQ(guess_sensor(without_above(vlp16, 0.0)).preset, "vlp16");   // 8, the lower half
+  EXPECT_EQ(guess_sensor(without_above(vlp16, -2.0)).preset, "auto");   // 7: too few to say
+  std::vector<LidarPoint> hdl32 = scan_of(world, "hdl32");
+  EXPECT_EQ(guess_sensor(without_above(hdl32, 3.0)).preset, "hdl32");   // 26 of 32
+  // Every other beam of a fan is another sensor (an OS1-32 is half an OS1-64): its own beams.
+  std::vector<LidarPoint> os64 = scan_of(world, "os1-64");
+  os64.erase(std::remove_if(os64.begin(), os64.end(), [](const LidarPoint& p) { return p.ring % 2 == 1; }),
+             os64.end());
+  const SensorGuess half = guess_sensor(os64);
+  EXPECT_EQ(half.layout.elevations_deg.size(), 32u) << half.reason;
+  EXPECT_EQ(half.preset, "auto") << half.reason;
 }
 
 TEST(SensorDetection, TooFewReturnsKeepTheDefaults) {

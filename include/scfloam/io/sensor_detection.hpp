@@ -18,9 +18,11 @@ struct SensorGuess {
   BeamLayout layout;   // the beams the guess was made from
 };
 
-// The built-in ring tables that describe `layout`: as many beams as the table (a few of a
-// sparse sensor's upper beams may see nothing), no two beams in one ring, at most 1 in 20 of
-// the table's beams outside its field of view. In the order hdl64, hdl32, vlp16, os1-64, os1-128.
+// The built-in ring tables that describe `layout`: as many beams as the table (up to 1 in 8
+// missing), no two beams in one ring, at most 1 in 20 of the table's beams outside its field
+// of view; or, for the uniform fans, at least half of the fan's beams, consecutive, each within
+// a fifth of the spacing of its nominal elevation (the top beams under open sky). In the order
+// hdl64, hdl32, vlp16, os1-64, os1-128.
 std::vector<LidarModel> matching_ring_tables(const BeamLayout& layout);
 
 // From the beams of `points` (all returns in the sensor frame; several scans may be joined):
