@@ -45,6 +45,12 @@ void print_report(const nlohmann::json& summary) {
   if (elevation["first_frame"].get<double>() != elevation["last_frame"].get<double>())
     std::printf("elevation correction estimated online: %.3f deg at the first frame, %.3f deg at the last\n",
                 elevation["first_frame"].get<double>(), elevation["last_frame"].get<double>());
+  const auto& deskew = summary["deskew"];
+  if (deskew.contains("residual_ratio"))
+    std::printf("deskew check: %s (frame %zu, %zu frames compared, deskewed / raw residual %.2f)%s\n",
+                deskew["check"].get<std::string>().c_str(), deskew["decided_at_frame"].get<std::size_t>(),
+                deskew["frames_compared"].get<std::size_t>(), deskew["residual_ratio"].get<double>(),
+                deskew["check"] == "compensated" ? ": the scans are already motion-compensated, deskew turned off" : "");
   const auto& rings = summary["rings"];
   if (rings["source"] == "learned")
     std::printf("rings from the scans' own %d beams (%+.2f .. %+.2f deg): %s\n", rings["beams"].get<int>(),
@@ -178,7 +184,9 @@ void run(const RunArgs& args) {
   if (args.sensor.empty() && per_point_times && !config.odometry.preprocess.deskew && !config_sets_deskew) {
     config.odometry.preprocess.deskew = true;
     guess.reason += "; deskew on: the scans carry per-point times";
-    if (!args.quiet) std::fprintf(stderr, "sensor: deskew on, the scans carry per-point times\n");
+    if (!args.quiet)
+      std::fprintf(stderr, "sensor: deskew on, the scans carry per-point times (checked in the first frames: "
+                           "compensated scans continue without it)\n");
   }
   OutputOptions outputs;
   outputs.map_voxel_m = args.map_voxel_m;

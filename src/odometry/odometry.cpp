@@ -54,6 +54,16 @@ struct Odometry::Impl {
   Eigen::Vector3d last_cleanup_position = Eigen::Vector3d::Zero();
   std::optional<ElevationCalibration> elevation;  // when the config estimates the offset
   std::optional<GroundElevationEstimate> ground_elevation;  // ... or takes it from the road's shape
+
+  // The deskew check (PreprocessConfig::deskew_check): the same scans without deskew, each in
+  // its own map, and the per-frame ratios of the two solves' mean residuals.
+  std::unique_ptr<Odometry> raw_shadow;
+  std::vector<double> residual_ratios;
+  DeskewCheck check;
+  // This odometry's world frame in the caller's: identity, unless the check switched to the
+  // raw shadow, whose world frame differs from the one already reported by the few frames of
+  // the trial.
+  Eigen::Isometry3d T_out_own = Eigen::Isometry3d::Identity();
 };
 
 namespace {
@@ -138,7 +148,89 @@ Odometry::~Odometry() = default;
 
 const RingLayoutInfo& Odometry::ring_layout() const { return impl_->extractor.ring_layout(); }
 
+const DeskewCheck& Odometry::deskew_check() const { return impl_->check; }
+
 OdometryResult Odometry::process(const Scan& scan) {
+  Impl& s = *impl_;
+  const PreprocessConfig& p = s.config.preprocess;
+  if (s.check.verdict == "off" && p.deskew) s.check.verdict = p.deskew_check ? "pending" : "unchecked";
+  const bool trial = p.deskew && p.deskew_check && scan.has_time &&
+                     (s.check.verdict == "pending" || s.check.verdict == "trial");
+  OdometryResult raw;
+  if (trial) {
+    if (!s.raw_shadow) {
+      OdometryConfig raw_config = s.config;
+      raw_config.preprocess.deskew = false;
+      s.raw_shadow = std::make_unique<Odometry>(raw_config);
+      s.check.verdict = "trial";
+    }
+    raw = s.raw_shadow->process(scan);
+  }
+  OdometryResult result = process_frame(scan);
+  result.T_world_lidar = s.T_out_own * result.T_world_lidar;
+  if (trial) {
+    // The trial's cost shows in the frame's timings.
+    result.features_ms += raw.features_ms;
+    result.registration_ms += raw.registration_ms;
+    compare_with_raw(scan, result, raw);  // may replace impl_ (and `s` with it)
+  }
+  return result;
+}
+
+void Odometry::compare_with_raw(const Scan& scan, const OdometryResult& deskewed, const OdometryResult& raw) {
+  Impl& s = *impl_;
+  // Only frames in motion tell the two apart: at 2 m/s a 0.1 s sweep moves 0.2 m.
+  float t_min = 0, t_max = 0;
+  for (const LidarPoint& pt : scan.points) t_min = std::min(t_min, pt.time_s), t_max = std::max(t_max, pt.time_s);
+  const double speed = s.delta_dt_s > 0 ? s.T_delta.translation().norm() / s.delta_dt_s : 0.0;
+  const bool solved = !deskewed.degenerate && !raw.degenerate && deskewed.mean_residual_m > 0 && raw.mean_residual_m > 0;
+  // From the fifth frame: the first ones match maps of one or two scans.
+  if (s.frames >= 5 && solved && speed * (t_max - t_min) >= 0.2)
+    s.residual_ratios.push_back(deskewed.mean_residual_m / raw.mean_residual_m);
+  // The two maps grow apart as each takes in its own version of the scans, so the latest
+  // frames say most: of the last 15 compared, 13 must agree on which fits better, and their
+  // median ratio must be 5 % off 1.
+  constexpr std::size_t kWindow = 15, kAgree = 13;
+  const std::size_t n = s.residual_ratios.size();
+  if (n < kWindow) {
+    // 300 frames and hardly any motion (or times that span nothing): deskew changes little
+    // here, and the second odometry's cost is not worth carrying further.
+    if (s.frames >= 300) {
+      s.check.verdict = "undecided";
+      s.check.frames_compared = n;
+      s.check.decided_at_frame = s.frames - 1;
+      s.raw_shadow.reset();
+    }
+    return;
+  }
+  const std::vector<double> last(s.residual_ratios.end() - kWindow, s.residual_ratios.end());
+  const auto deskew_better = static_cast<std::size_t>(std::count_if(last.begin(), last.end(), [](double r) { return r < 1; }));
+  const double ratio = summarize(last).median;
+  s.check.frames_compared = n;
+  s.check.residual_ratio = ratio;
+  s.check.decided_at_frame = s.frames - 1;
+  const bool distorted = deskew_better >= kAgree && ratio < 0.95;
+  const bool compensated = kWindow - deskew_better >= kAgree && ratio > 1.05;
+  if (distorted || (!compensated && n >= 100)) {
+    s.check.verdict = distorted ? "distorted" : "undecided";
+    s.raw_shadow.reset();
+    std::vector<double>().swap(s.residual_ratios);
+    return;
+  }
+  if (!compensated) return;
+  // The raw scans fit better: they are already compensated. Continue as the shadow, whose world
+  // frame is put where this frame was reported.
+  DeskewCheck check = s.check;
+  check.verdict = "compensated";
+  const Eigen::Isometry3d T_out_raw = deskewed.T_world_lidar * raw.T_world_lidar.inverse();
+  std::unique_ptr<Odometry> shadow = std::move(s.raw_shadow);
+  std::swap(impl_, shadow->impl_);
+  impl_->check = check;
+  impl_->T_out_own = T_out_raw;
+  // `shadow` now holds this odometry's former state, released here.
+}
+
+OdometryResult Odometry::process_frame(const Scan& scan) {
   Impl& s = *impl_;
   const OdometryConfig& c = s.config;
   OdometryResult result;
@@ -315,10 +407,11 @@ void Odometry::reset_map(
   Impl& s = *impl_;
   s.map.clear();
   static const FeatureCloud kEmpty;
-  for (const auto& [T, cloud] : edges_by_pose) s.map.insert(cloud ? *cloud : kEmpty, kEmpty, T);
-  for (const auto& [T, cloud] : planes_by_pose) s.map.insert(kEmpty, cloud ? *cloud : kEmpty, T);
+  const Eigen::Isometry3d T_own_out = s.T_out_own.inverse();  // the caller's poses in our frame
+  for (const auto& [T, cloud] : edges_by_pose) s.map.insert(cloud ? *cloud : kEmpty, kEmpty, T_own_out * T);
+  for (const auto& [T, cloud] : planes_by_pose) s.map.insert(kEmpty, cloud ? *cloud : kEmpty, T_own_out * T);
   // Keep the current velocity: T_delta is relative, so it survives the correction unchanged.
-  s.T_last = orthonormalized(T_world_lidar_now);
+  s.T_last = orthonormalized(T_own_out * T_world_lidar_now);
   s.map.remove_far(s.T_last.translation(), s.config.map.radius_m);
   s.last_cleanup_position = s.T_last.translation();
 }

@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "scfloam/config.hpp"
@@ -36,6 +37,16 @@ struct OdometryResult {
   double elevation_correction_deg = 0;  // applied to this frame's features
 };
 
+// What the deskew check (PreprocessConfig::deskew_check) found.
+struct DeskewCheck {
+  // "off" (deskew not configured, or no per-point times), "trial" (still measuring),
+  // "distorted" (deskew kept), "compensated" (deskew turned off), "undecided" (deskew kept).
+  std::string verdict = "off";
+  std::size_t decided_at_frame = 0;  // frame index of the decision
+  std::size_t frames_compared = 0;   // frames in motion whose two solves were compared
+  double residual_ratio = 0;         // median of deskewed / raw mean residual over them
+};
+
 class Odometry {
  public:
   explicit Odometry(const OdometryConfig& config);
@@ -46,6 +57,7 @@ class Odometry {
   OdometryResult process(const Scan& scan);
   // Where the feature extraction's rings come from (a table, learned beams, the ring field).
   const RingLayoutInfo& ring_layout() const;
+  const DeskewCheck& deskew_check() const;
 
   // After a loop closure the pipeline moves past keyframes: rebuild the local map from
   // (corrected pose, features) pairs and continue from `T_world_lidar_now`.
@@ -55,6 +67,10 @@ class Odometry {
 
  private:
   void redeskew_first_frames(const Eigen::Vector3d& omega_rad_s, const Eigen::Vector3d& velocity_m_s);
+  // One frame in the odometry's own world frame (see Impl::T_out_own).
+  OdometryResult process_frame(const Scan& scan);
+  // The deskew check's comparison of this frame's solve with the raw-scan odometry's.
+  void compare_with_raw(const Scan& scan, const OdometryResult& deskewed, const OdometryResult& raw);
 
   struct Impl;
   std::unique_ptr<Impl> impl_;

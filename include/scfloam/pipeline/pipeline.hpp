@@ -14,6 +14,7 @@
 #include "scfloam/features/feature_extractor.hpp"
 #include "scfloam/io/scan_source.hpp"
 #include "scfloam/loop/loop_candidate.hpp"
+#include "scfloam/odometry/odometry.hpp"
 #include "scfloam/pipeline/keyframe.hpp"
 #include "scfloam/types.hpp"
 
@@ -86,6 +87,7 @@ struct RunResult {
   // differ only when the config estimates it online).
   double elevation_correction_first_deg = 0, elevation_correction_last_deg = 0;
   RingLayoutInfo ring_layout;  // where the rings came from (the last change of source)
+  DeskewCheck deskew_check;    // whether the scans proved motion-distorted (at the last frame)
   // How many frames ran each number of correspondence rounds (index = rounds).
   std::vector<std::size_t> registration_rounds;
   // Per-stage samples in milliseconds ("features", "registration", ...).
