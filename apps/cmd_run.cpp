@@ -209,12 +209,10 @@ void run(const RunArgs& args) {
                  "~0.22 deg low (a steady pitch drift); --sensor kitti corrects that\n");
   if (args.sensor.empty() && guess.preset == "kitti" && args.config_file.empty() && !kitti_input)
     // The defaults carry KITTI's own calibration error: on another HDL-64E it costs 13x in
-    // drift (docs/odometry.md, "Session 19"). A ring table that does not fit the sensor is
-    // replaced by beams learned from the scans, but the leaf sizes and deskew stay KITTI's.
+    // drift (docs/odometry.md, "Session 19"); an HDL-64E's beams cannot tell KITTI's from another.
     std::fprintf(stderr,
                  "note: no --sensor or --config: using the defaults, made for KITTI's HDL-64E scans (beams "
-                 "raised 0.22 deg, no deskew); for your sensor pass --sensor hdl64 | hdl32 | vlp16 | os1-64 | "
-                 "os1-128, or auto for another spinning sensor\n");
+                 "raised 0.22 deg); for another HDL-64E pass --sensor hdl64\n");
   if (!config.odometry.preprocess.deskew && per_point_times)
     std::fprintf(stderr,
                  "note: the scans carry per-point times but deskew is off (KITTI's preset: its scans are "

@@ -141,7 +141,8 @@ TEST_F(RunOutputs, SensorPresetsLoadAndLivoxSaysWhyNot) {
     EXPECT_EQ(r.exit_code, 0) << sensor << ": " << r.output;
     EXPECT_EQ(r.output.find("no --sensor or --config"), std::string::npos) << sensor << ": " << r.output;
   }
-  // Without a preset a folder of scans runs on KITTI's defaults, and the run says so.
+  // Without a preset a folder of HDL-64E scans runs on KITTI's defaults (its beams cannot tell
+  // KITTI's sensor from another), and the run says so.
   Outcome plain = run_cli("run " + (root_ / "pcd").string() + " -o " + (root_ / "preset" / "none").string() +
                           " --mode odometry --quiet -n 2");
   EXPECT_EQ(plain.exit_code, 0) << plain.output;
