@@ -60,6 +60,7 @@ struct Odometry::Impl {
   std::unique_ptr<Odometry> raw_shadow;
   std::vector<double> residual_ratios;
   DeskewCheck check;
+  bool check_open = false;  // deskew and deskew_check on, no verdict yet
   // This odometry's world frame in the caller's: identity, unless the check switched to the
   // raw shadow, whose world frame differs from the one already reported by the few frames of
   // the trial.
@@ -153,9 +154,11 @@ const DeskewCheck& Odometry::deskew_check() const { return impl_->check; }
 OdometryResult Odometry::process(const Scan& scan) {
   Impl& s = *impl_;
   const PreprocessConfig& p = s.config.preprocess;
-  if (s.check.verdict == "off" && p.deskew) s.check.verdict = p.deskew_check ? "pending" : "unchecked";
-  const bool trial = p.deskew && p.deskew_check && scan.has_time &&
-                     (s.check.verdict == "pending" || s.check.verdict == "trial");
+  if (s.frames == 0 && p.deskew) {
+    s.check.verdict = p.deskew_check ? "no per-point times" : "unchecked";
+    s.check_open = p.deskew_check;
+  }
+  const bool trial = s.check_open && scan.has_time;
   OdometryResult raw;
   if (trial) {
     if (!s.raw_shadow) {
@@ -197,6 +200,7 @@ void Odometry::compare_with_raw(const Scan& scan, const OdometryResult& deskewed
     // here, and the second odometry's cost is not worth carrying further.
     if (s.frames >= 300) {
       s.check.verdict = "undecided";
+      s.check_open = false;
       s.check.frames_compared = n;
       s.check.decided_at_frame = s.frames - 1;
       s.raw_shadow.reset();
@@ -213,6 +217,7 @@ void Odometry::compare_with_raw(const Scan& scan, const OdometryResult& deskewed
   const bool compensated = kWindow - deskew_better >= kAgree && ratio > 1.05;
   if (distorted || (!compensated && n >= 100)) {
     s.check.verdict = distorted ? "distorted" : "undecided";
+    s.check_open = false;
     s.raw_shadow.reset();
     std::vector<double>().swap(s.residual_ratios);
     return;

@@ -135,9 +135,8 @@ nlohmann::json make_summary(const ScanSource& source, const RunResult& result) {
   summary["degenerate_frames"] = result.degenerate_frames;
   summary["elevation_correction_deg"] = {{"first_frame", result.elevation_correction_first_deg},
                                          {"last_frame", result.elevation_correction_last_deg}};
-  // "pending": deskew configured, but no scan carried per-point times.
   const DeskewCheck& deskew = result.deskew_check;
-  summary["deskew"] = {{"check", deskew.verdict == "pending" ? "no per-point times" : deskew.verdict}};
+  summary["deskew"] = {{"check", deskew.verdict}};
   if (deskew.frames_compared > 0) {
     summary["deskew"]["decided_at_frame"] = deskew.decided_at_frame;
     summary["deskew"]["frames_compared"] = deskew.frames_compared;

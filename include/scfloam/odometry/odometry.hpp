@@ -39,8 +39,10 @@ struct OdometryResult {
 
 // What the deskew check (PreprocessConfig::deskew_check) found.
 struct DeskewCheck {
-  // "off" (deskew not configured, or no per-point times), "trial" (still measuring),
+  // "off" (deskew not configured, or no frame yet), "unchecked" (deskew_check off), "no
+  // per-point times" (deskew configured, no timed scan yet), "trial" (still measuring),
   // "distorted" (deskew kept), "compensated" (deskew turned off), "undecided" (deskew kept).
+  // Set when it changes: the odometry's own test is a flag, not this text.
   std::string verdict = "off";
   std::size_t decided_at_frame = 0;  // frame index of the decision
   std::size_t frames_compared = 0;   // frames in motion whose two solves were compared
