@@ -42,7 +42,9 @@ void print_report(const nlohmann::json& summary) {
               summary["wall_s"].get<double>(), summary["fps"].get<double>(),
               summary["peak_rss_mb"].get<double>());
   const auto& elevation = summary["elevation_correction_deg"];
-  if (elevation["first_frame"].get<double>() != elevation["last_frame"].get<double>())
+  const auto& elevation_check = summary["elevation_check"];
+  if (elevation["first_frame"].get<double>() != elevation["last_frame"].get<double>() &&
+      elevation_check["check"] != "no offset")
     std::printf("elevation correction estimated online: %.3f deg at the first frame, %.3f deg at the last\n",
                 elevation["first_frame"].get<double>(), elevation["last_frame"].get<double>());
   const auto& deskew = summary["deskew"];
@@ -51,6 +53,15 @@ void print_report(const nlohmann::json& summary) {
                 deskew["check"].get<std::string>().c_str(), deskew["decided_at_frame"].get<std::size_t>(),
                 deskew["frames_compared"].get<std::size_t>(), deskew["residual_ratio"].get<double>(),
                 deskew["check"] == "compensated" ? ": the scans are already motion-compensated, deskew turned off" : "");
+  if (elevation_check.contains("residual_ratio"))
+    std::printf("elevation check: %s (frame %zu, %zu frames compared, corrected / uncorrected residual %.2f)%s\n",
+                elevation_check["check"].get<std::string>().c_str(),
+                elevation_check["decided_at_frame"].get<std::size_t>(),
+                elevation_check["frames_compared"].get<std::size_t>(),
+                elevation_check["residual_ratio"].get<double>(),
+                elevation_check["check"] == "no offset"
+                    ? ": the beams are where the scans say, the elevation correction turned off"
+                    : "");
   const auto& rings = summary["rings"];
   if (rings["source"] == "learned")
     std::printf("rings from the scans' own %d beams (%+.2f .. %+.2f deg): %s\n", rings["beams"].get<int>(),
@@ -207,12 +218,6 @@ void run(const RunArgs& args) {
     std::fprintf(stderr,
                  "note: an HDL-64E without elevation correction on a KITTI sequence: KITTI's own scans read "
                  "~0.22 deg low (a steady pitch drift); --sensor kitti corrects that\n");
-  if (args.sensor.empty() && guess.preset == "kitti" && args.config_file.empty() && !kitti_input)
-    // The defaults carry KITTI's own calibration error: on another HDL-64E it costs 13x in
-    // drift (docs/odometry.md, "Session 19"); an HDL-64E's beams cannot tell KITTI's from another.
-    std::fprintf(stderr,
-                 "note: no --sensor or --config: using the defaults, made for KITTI's HDL-64E scans (beams "
-                 "raised 0.22 deg); for another HDL-64E pass --sensor hdl64\n");
   if (!config.odometry.preprocess.deskew && per_point_times)
     std::fprintf(stderr,
                  "note: the scans carry per-point times but deskew is off (KITTI's preset: its scans are "

@@ -34,6 +34,7 @@ std::vector<Binding> bindings(SlamConfig& c) {
       {pre, "max_range_m", &o.preprocess.max_range_m},
       {pre, "deskew", &o.preprocess.deskew},
       {pre, "deskew_check", &o.preprocess.deskew_check},
+      {pre, "elevation_check", &o.preprocess.elevation_check},
       {pre, "elevation_correction_deg", &o.preprocess.elevation_correction_deg},
       {pre, "online_elevation_calibration", &o.preprocess.online_elevation_calibration},
       {pre, "elevation_calibration_gain", &o.preprocess.elevation_calibration_gain},

@@ -55,15 +55,20 @@ struct Odometry::Impl {
   std::optional<ElevationCalibration> elevation;  // when the config estimates the offset
   std::optional<GroundElevationEstimate> ground_elevation;  // ... or takes it from the road's shape
 
-  // The deskew check (PreprocessConfig::deskew_check): the same scans without deskew, each in
-  // its own map, and the per-frame ratios of the two solves' mean residuals.
-  std::unique_ptr<Odometry> raw_shadow;
+  // The setting checks (PreprocessConfig::deskew_check, elevation_check), one trial at a
+  // time: a shadow odometry runs the same scans with the setting flipped, in its own map, and
+  // the per-frame ratios of the two solves' mean residuals decide.
+  SettingCheck deskew_check, elevation_check;
+  bool deskew_open = false, elevation_open = false;  // configured, no verdict yet
+  enum class Trial { kNone, kDeskew, kElevation } trial = Trial::kNone;
+  std::unique_ptr<Odometry> shadow;
+  std::size_t trial_frames = 0;  // frames the shadow has seen
+  // The first frame of the trial as reported (this odometry's) and in the shadow's own frame.
+  std::pair<Eigen::Isometry3d, Eigen::Isometry3d> trial_start;
+  std::size_t first_frame = 0;   // the caller's index of this odometry's first frame
   std::vector<double> residual_ratios;
-  DeskewCheck check;
-  bool check_open = false;  // deskew and deskew_check on, no verdict yet
-  // This odometry's world frame in the caller's: identity, unless the check switched to the
-  // raw shadow, whose world frame differs from the one already reported by the few frames of
-  // the trial.
+  // This odometry's world frame in the caller's: identity, unless a check switched to the
+  // shadow, whose world frame differs from the one already reported by the frames of the trial.
   Eigen::Isometry3d T_out_own = Eigen::Isometry3d::Identity();
 };
 
@@ -149,89 +154,135 @@ Odometry::~Odometry() = default;
 
 const RingLayoutInfo& Odometry::ring_layout() const { return impl_->extractor.ring_layout(); }
 
-const DeskewCheck& Odometry::deskew_check() const { return impl_->check; }
+const SettingCheck& Odometry::deskew_check() const { return impl_->deskew_check; }
+const SettingCheck& Odometry::elevation_check() const { return impl_->elevation_check; }
 
 OdometryResult Odometry::process(const Scan& scan) {
   Impl& s = *impl_;
   const PreprocessConfig& p = s.config.preprocess;
-  if (s.frames == 0 && p.deskew) {
-    s.check.verdict = p.deskew_check ? "no per-point times" : "unchecked";
-    s.check_open = p.deskew_check;
-  }
-  const bool trial = s.check_open && scan.has_time;
-  OdometryResult raw;
-  if (trial) {
-    if (!s.raw_shadow) {
-      OdometryConfig raw_config = s.config;
-      raw_config.preprocess.deskew = false;
-      s.raw_shadow = std::make_unique<Odometry>(raw_config);
-      s.check.verdict = "trial";
+  if (s.frames == 0) {
+    if (p.deskew) {
+      s.deskew_check.verdict = p.deskew_check ? "no per-point times" : "unchecked";
+      s.deskew_open = p.deskew_check;
     }
-    raw = s.raw_shadow->process(scan);
+    // The online estimators move the correction themselves.
+    if (p.elevation_correction_deg != 0 && !p.online_elevation_calibration && !p.ground_elevation_calibration) {
+      s.elevation_check.verdict = p.elevation_check ? "waiting" : "unchecked";
+      s.elevation_open = p.elevation_check;
+    }
+  }
+  // A trial runs to its verdict; the deskew check goes first (on timed scans), since whether
+  // the scans are distorted changes every residual the elevation check compares.
+  if (s.trial == Impl::Trial::kNone) {
+    if (s.deskew_open && scan.has_time) s.trial = Impl::Trial::kDeskew;
+    else if (s.elevation_open) s.trial = Impl::Trial::kElevation;
+  }
+  OdometryResult other;
+  if (s.trial != Impl::Trial::kNone) {
+    if (!s.shadow) {
+      OdometryConfig flipped = s.config;
+      flipped.preprocess.deskew_check = flipped.preprocess.elevation_check = false;
+      if (s.trial == Impl::Trial::kDeskew) {
+        flipped.preprocess.deskew = false;
+        s.deskew_check.verdict = "trial";
+      } else {
+        flipped.preprocess.elevation_correction_deg = 0;
+        s.elevation_check.verdict = "trial";
+      }
+      s.shadow = std::make_unique<Odometry>(flipped);
+      s.trial_frames = 0;
+    }
+    other = s.shadow->process(scan);
+    ++s.trial_frames;
   }
   OdometryResult result = process_frame(scan);
   result.T_world_lidar = s.T_out_own * result.T_world_lidar;
-  if (trial) {
+  if (s.trial != Impl::Trial::kNone) {
     // The trial's cost shows in the frame's timings.
-    result.features_ms += raw.features_ms;
-    result.registration_ms += raw.registration_ms;
-    compare_with_raw(scan, result, raw);  // may replace impl_ (and `s` with it)
+    result.features_ms += other.features_ms;
+    result.registration_ms += other.registration_ms;
+    if (s.trial_frames == 1) s.trial_start = {result.T_world_lidar, other.T_world_lidar};
+    compare_with_shadow(scan, result, other);  // may replace impl_ (and `s` with it)
   }
   return result;
 }
 
-void Odometry::compare_with_raw(const Scan& scan, const OdometryResult& deskewed, const OdometryResult& raw) {
+void Odometry::compare_with_shadow(const Scan& scan, const OdometryResult& own, const OdometryResult& other) {
   Impl& s = *impl_;
-  // Only frames in motion tell the two apart: at 2 m/s a 0.1 s sweep moves 0.2 m.
-  float t_min = 0, t_max = 0;
-  for (const LidarPoint& pt : scan.points) t_min = std::min(t_min, pt.time_s), t_max = std::max(t_max, pt.time_s);
+  const bool deskew = s.trial == Impl::Trial::kDeskew;
+  SettingCheck& check = deskew ? s.deskew_check : s.elevation_check;
   const double speed = s.delta_dt_s > 0 ? s.T_delta.translation().norm() / s.delta_dt_s : 0.0;
-  const bool solved = !deskewed.degenerate && !raw.degenerate && deskewed.mean_residual_m > 0 && raw.mean_residual_m > 0;
-  // From the fifth frame: the first ones match maps of one or two scans.
-  if (s.frames >= 5 && solved && speed * (t_max - t_min) >= 0.2)
-    s.residual_ratios.push_back(deskewed.mean_residual_m / raw.mean_residual_m);
+  // Only frames in motion tell the two apart. Deskew: at 2 m/s a 0.1 s sweep moves 0.2 m.
+  // Elevation: a wrong offset lifts a point by its range times the error, so it shows where a
+  // surface is seen from two places at different ranges: 0.2 m between frames.
+  double moved_m = s.delta_dt_s > 0 ? s.T_delta.translation().norm() : 0.0;
+  if (deskew) {
+    float t_min = 0, t_max = 0;
+    for (const LidarPoint& pt : scan.points) t_min = std::min(t_min, pt.time_s), t_max = std::max(t_max, pt.time_s);
+    moved_m = speed * (t_max - t_min);
+  }
+  const bool solved = !own.degenerate && !other.degenerate && own.mean_residual_m > 0 && other.mean_residual_m > 0;
+  // From the shadow's fifth frame: the first ones match maps of one or two scans.
+  if (s.trial_frames > 5 && solved && moved_m >= 0.2)
+    s.residual_ratios.push_back(own.mean_residual_m / other.mean_residual_m);
   // The two maps grow apart as each takes in its own version of the scans, so the latest
   // frames say most: of the last 15 compared, 13 must agree on which fits better, and their
   // median ratio must be 5 % off 1.
   constexpr std::size_t kWindow = 15, kAgree = 13;
   const std::size_t n = s.residual_ratios.size();
+  const auto close = [&](const char* verdict) {
+    check.verdict = verdict;
+    check.frames_compared = n;
+    check.decided_at_frame = s.first_frame + s.frames - 1;
+    (deskew ? s.deskew_open : s.elevation_open) = false;
+    s.trial = Impl::Trial::kNone;
+    s.shadow.reset();
+    std::vector<double>().swap(s.residual_ratios);
+  };
   if (n < kWindow) {
-    // 300 frames and hardly any motion (or times that span nothing): deskew changes little
-    // here, and the second odometry's cost is not worth carrying further.
-    if (s.frames >= 300) {
-      s.check.verdict = "undecided";
-      s.check_open = false;
-      s.check.frames_compared = n;
-      s.check.decided_at_frame = s.frames - 1;
-      s.raw_shadow.reset();
-    }
+    // 300 frames and hardly any motion (or times that span nothing): the setting changes
+    // little here, and the second odometry's cost is not worth carrying further.
+    if (s.trial_frames >= 300) close("undecided");
     return;
   }
   const std::vector<double> last(s.residual_ratios.end() - kWindow, s.residual_ratios.end());
-  const auto deskew_better = static_cast<std::size_t>(std::count_if(last.begin(), last.end(), [](double r) { return r < 1; }));
+  const auto own_better = static_cast<std::size_t>(std::count_if(last.begin(), last.end(), [](double r) { return r < 1; }));
   const double ratio = summarize(last).median;
-  s.check.frames_compared = n;
-  s.check.residual_ratio = ratio;
-  s.check.decided_at_frame = s.frames - 1;
-  const bool distorted = deskew_better >= kAgree && ratio < 0.95;
-  const bool compensated = kWindow - deskew_better >= kAgree && ratio > 1.05;
-  if (distorted || (!compensated && n >= 100)) {
-    s.check.verdict = distorted ? "distorted" : "undecided";
-    s.check_open = false;
-    s.raw_shadow.reset();
-    std::vector<double>().swap(s.residual_ratios);
+  check.residual_ratio = ratio;
+  const bool keep = own_better >= kAgree && ratio < 0.95;
+  const bool flip = kWindow - own_better >= kAgree && ratio > 1.05;
+  if (keep || (!flip && n >= 100)) {
+    close(!keep ? "undecided" : deskew ? "distorted" : "offset");
     return;
   }
-  if (!compensated) return;
-  // The raw scans fit better: they are already compensated. Continue as the shadow, whose world
-  // frame is put where this frame was reported.
-  DeskewCheck check = s.check;
-  check.verdict = "compensated";
-  const Eigen::Isometry3d T_out_raw = deskewed.T_world_lidar * raw.T_world_lidar.inverse();
-  std::unique_ptr<Odometry> shadow = std::move(s.raw_shadow);
+  if (!flip) return;
+  // The other setting fits better. Continue as the shadow, whose world frame is put where this
+  // frame was reported; the checks' records (and any check still to run) come along.
+  check.verdict = deskew ? "compensated" : "no offset";
+  check.frames_compared = n;
+  check.decided_at_frame = s.first_frame + s.frames - 1;
+  (deskew ? s.deskew_open : s.elevation_open) = false;
+  const SettingCheck deskew_record = s.deskew_check, elevation_record = s.elevation_check;
+  const bool deskew_open = s.deskew_open, elevation_open = s.elevation_open;
+  // The shadow's attitude is the better one since the trial began (this odometry's carries
+  // what the trial frames' setting did to it: with a wrong elevation offset, a tilt that would
+  // stay for the rest of the drive), so its world frame is turned to where this odometry was
+  // at the trial's first frame; its position continues from this frame's, so the reported
+  // track does not jump.
+  Eigen::Isometry3d T_out_other = Eigen::Isometry3d::Identity();
+  T_out_other.linear() = s.trial_start.first.linear() * s.trial_start.second.linear().transpose();
+  T_out_other.translation() = own.T_world_lidar.translation() - T_out_other.linear() * other.T_world_lidar.translation();
+  // The caller's index of the shadow's first frame (it started with the trial).
+  const std::size_t first_frame = s.first_frame + s.frames - s.trial_frames;
+  std::unique_ptr<Odometry> shadow = std::move(s.shadow);
   std::swap(impl_, shadow->impl_);
-  impl_->check = check;
-  impl_->T_out_own = T_out_raw;
+  Impl& now = *impl_;
+  now.deskew_check = deskew_record;
+  now.elevation_check = elevation_record;
+  now.deskew_open = deskew_open;
+  now.elevation_open = elevation_open;
+  now.first_frame = first_frame;
+  now.T_out_own = T_out_other;
   // `shadow` now holds this odometry's former state, released here.
 }
 

@@ -135,13 +135,17 @@ nlohmann::json make_summary(const ScanSource& source, const RunResult& result) {
   summary["degenerate_frames"] = result.degenerate_frames;
   summary["elevation_correction_deg"] = {{"first_frame", result.elevation_correction_first_deg},
                                          {"last_frame", result.elevation_correction_last_deg}};
-  const DeskewCheck& deskew = result.deskew_check;
-  summary["deskew"] = {{"check", deskew.verdict}};
-  if (deskew.frames_compared > 0) {
-    summary["deskew"]["decided_at_frame"] = deskew.decided_at_frame;
-    summary["deskew"]["frames_compared"] = deskew.frames_compared;
-    summary["deskew"]["residual_ratio"] = deskew.residual_ratio;
-  }
+  const auto check_json = [](const SettingCheck& check) {
+    nlohmann::json out = {{"check", check.verdict}};
+    if (check.frames_compared > 0) {
+      out["decided_at_frame"] = check.decided_at_frame;
+      out["frames_compared"] = check.frames_compared;
+      out["residual_ratio"] = check.residual_ratio;
+    }
+    return out;
+  };
+  summary["deskew"] = check_json(result.deskew_check);
+  summary["elevation_check"] = check_json(result.elevation_check);
   nlohmann::json rings = {{"source", result.ring_layout.source}, {"beams", result.ring_layout.beams}};
   if (result.ring_layout.source == "learned") {
     rings["highest_deg"] = result.ring_layout.highest_deg;

@@ -257,6 +257,7 @@ class OdometryStage {
     if (result.stamps_s.size() == 1) result.elevation_correction_first_deg = odom.elevation_correction_deg;
     result.elevation_correction_last_deg = odom.elevation_correction_deg;
     result.deskew_check = odometry_.deskew_check();
+    result.elevation_check = odometry_.elevation_check();
     if (result.stamps_s.size() == 1 || result.ring_layout.source != odometry_.ring_layout().source)
       result.ring_layout = odometry_.ring_layout();
     const auto rounds = static_cast<std::size_t>(std::max(0, odom.registration_rounds));

@@ -37,16 +37,23 @@ struct OdometryResult {
   double elevation_correction_deg = 0;  // applied to this frame's features
 };
 
-// What the deskew check (PreprocessConfig::deskew_check) found.
-struct DeskewCheck {
-  // "off" (deskew not configured, or no frame yet), "unchecked" (deskew_check off), "no
+// What one of the odometry's setting checks found (PreprocessConfig::deskew_check,
+// elevation_check): the scans run both ways for a while, each way in its own map, and the
+// setting whose solves fit their map better is kept.
+struct SettingCheck {
+  // Deskew: "off" (deskew not configured, or no frame yet), "unchecked" (deskew_check off), "no
   // per-point times" (deskew configured, no timed scan yet), "trial" (still measuring),
   // "distorted" (deskew kept), "compensated" (deskew turned off), "undecided" (deskew kept).
+  // Elevation: "off" (no correction configured, or it is estimated online), "unchecked"
+  // (elevation_check off), "waiting" (for the deskew check), "trial", "offset" (the
+  // correction kept), "no offset" (the correction removed), "undecided" (the correction kept).
   // Set when it changes: the odometry's own test is a flag, not this text.
   std::string verdict = "off";
   std::size_t decided_at_frame = 0;  // frame index of the decision
   std::size_t frames_compared = 0;   // frames in motion whose two solves were compared
-  double residual_ratio = 0;         // median of deskewed / raw mean residual over them
+  // Median over them of the configured way's mean residual / the other way's (deskewed / raw;
+  // corrected / uncorrected).
+  double residual_ratio = 0;
 };
 
 class Odometry {
@@ -59,7 +66,8 @@ class Odometry {
   OdometryResult process(const Scan& scan);
   // Where the feature extraction's rings come from (a table, learned beams, the ring field).
   const RingLayoutInfo& ring_layout() const;
-  const DeskewCheck& deskew_check() const;
+  const SettingCheck& deskew_check() const;
+  const SettingCheck& elevation_check() const;
 
   // After a loop closure the pipeline moves past keyframes: rebuild the local map from
   // (corrected pose, features) pairs and continue from `T_world_lidar_now`.
@@ -71,8 +79,9 @@ class Odometry {
   void redeskew_first_frames(const Eigen::Vector3d& omega_rad_s, const Eigen::Vector3d& velocity_m_s);
   // One frame in the odometry's own world frame (see Impl::T_out_own).
   OdometryResult process_frame(const Scan& scan);
-  // The deskew check's comparison of this frame's solve with the raw-scan odometry's.
-  void compare_with_raw(const Scan& scan, const OdometryResult& deskewed, const OdometryResult& raw);
+  // A setting check's comparison of this frame's solve with the shadow odometry's (the other
+  // setting); may continue as the shadow.
+  void compare_with_shadow(const Scan& scan, const OdometryResult& own, const OdometryResult& other);
 
   struct Impl;
   std::unique_ptr<Impl> impl_;

@@ -87,7 +87,8 @@ struct RunResult {
   // differ only when the config estimates it online).
   double elevation_correction_first_deg = 0, elevation_correction_last_deg = 0;
   RingLayoutInfo ring_layout;  // where the rings came from (the last change of source)
-  DeskewCheck deskew_check;    // whether the scans proved motion-distorted (at the last frame)
+  SettingCheck deskew_check;    // whether the scans proved motion-distorted (at the last frame)
+  SettingCheck elevation_check;  // whether the scans proved to need the elevation correction
   // How many frames ran each number of correspondence rounds (index = rounds).
   std::vector<std::size_t> registration_rounds;
   // Per-stage samples in milliseconds ("features", "registration", ...).
