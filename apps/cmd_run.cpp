@@ -36,6 +36,19 @@ struct RunArgs {
   bool deterministic = false;
 };
 
+// A setting check's verdict (summary.json's `deskew` or `elevation_check`), once decided:
+// "deskew check: distorted (frame 19, 15 frames compared, deskewed / raw residual 0.80)".
+void print_check(const char* name, const nlohmann::json& check, const char* ratio_name,
+                 const char* switched_verdict, const char* switched_text) {
+  if (!check.contains("decided_at_frame")) return;
+  std::printf("%s: %s (frame %zu, %zu frames compared", name, check["check"].get<std::string>().c_str(),
+              check["decided_at_frame"].get<std::size_t>(), check["frames_compared"].get<std::size_t>());
+  if (check.contains("residual_ratio"))
+    std::printf(", %s residual %.2f", ratio_name, check["residual_ratio"].get<double>());
+  std::printf(")%s%s\n", check["check"] == switched_verdict ? ": " : "",
+              check["check"] == switched_verdict ? switched_text : "");
+}
+
 void print_report(const nlohmann::json& summary) {
   std::printf("frames %zu, keyframes %zu, %.1f s wall, %.1f frames/s, peak memory %.0f MB\n",
               summary["frames"].get<std::size_t>(), summary["keyframes"].get<std::size_t>(),
@@ -47,21 +60,10 @@ void print_report(const nlohmann::json& summary) {
       elevation_check["check"] != "no offset")
     std::printf("elevation correction estimated online: %.3f deg at the first frame, %.3f deg at the last\n",
                 elevation["first_frame"].get<double>(), elevation["last_frame"].get<double>());
-  const auto& deskew = summary["deskew"];
-  if (deskew.contains("residual_ratio"))
-    std::printf("deskew check: %s (frame %zu, %zu frames compared, deskewed / raw residual %.2f)%s\n",
-                deskew["check"].get<std::string>().c_str(), deskew["decided_at_frame"].get<std::size_t>(),
-                deskew["frames_compared"].get<std::size_t>(), deskew["residual_ratio"].get<double>(),
-                deskew["check"] == "compensated" ? ": the scans are already motion-compensated, deskew turned off" : "");
-  if (elevation_check.contains("residual_ratio"))
-    std::printf("elevation check: %s (frame %zu, %zu frames compared, corrected / uncorrected residual %.2f)%s\n",
-                elevation_check["check"].get<std::string>().c_str(),
-                elevation_check["decided_at_frame"].get<std::size_t>(),
-                elevation_check["frames_compared"].get<std::size_t>(),
-                elevation_check["residual_ratio"].get<double>(),
-                elevation_check["check"] == "no offset"
-                    ? ": the beams are where the scans say, the elevation correction turned off"
-                    : "");
+  print_check("deskew check", summary["deskew"], "deskewed / raw", "compensated",
+              "the scans are already motion-compensated, deskew turned off");
+  print_check("elevation check", elevation_check, "corrected / uncorrected", "no offset",
+              "the beams are where the scans say, the elevation correction turned off");
   const auto& rings = summary["rings"];
   if (rings["source"] == "learned")
     std::printf("rings from the scans' own %d beams (%+.2f .. %+.2f deg): %s\n", rings["beams"].get<int>(),

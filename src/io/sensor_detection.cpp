@@ -79,7 +79,7 @@ SensorGuess guess_sensor(const std::vector<LidarPoint>& points) {
     std::snprintf(line, sizeof line, "%zu beams, %+.2f .. %+.2f deg: %s", layout.elevations_deg.size(),
                   layout.elevations_deg.front(), layout.elevations_deg.back(),
                   tables.empty() ? "no preset's ring table matches them, rings from the learned beams"
-                  : tables.front() == LidarModel::hdl64 ? "an HDL-64E, the defaults (KITTI's)"
+                  : tables.front() == LidarModel::hdl64 ? "an HDL-64E, the defaults (KITTI's; its beam correction kept if the first frames fit better with it)"
                                                         : "its preset's ring table matches them");
   }
   guess.reason = line;

@@ -63,6 +63,7 @@ struct Odometry::Impl {
   enum class Trial { kNone, kDeskew, kElevation } trial = Trial::kNone;
   std::unique_ptr<Odometry> shadow;
   std::size_t trial_frames = 0;  // frames the shadow has seen
+  std::size_t check_frames = 0;  // frames since the running check began (a shadow may restart)
   // The first frame of the trial as reported (this odometry's) and in the shadow's own frame.
   std::pair<Eigen::Isometry3d, Eigen::Isometry3d> trial_start;
   std::size_t first_frame = 0;   // the caller's index of this odometry's first frame
@@ -176,6 +177,7 @@ OdometryResult Odometry::process(const Scan& scan) {
   if (s.trial == Impl::Trial::kNone) {
     if (s.deskew_open && scan.has_time) s.trial = Impl::Trial::kDeskew;
     else if (s.elevation_open) s.trial = Impl::Trial::kElevation;
+    s.check_frames = 0;
   }
   OdometryResult other;
   if (s.trial != Impl::Trial::kNone) {
@@ -194,6 +196,7 @@ OdometryResult Odometry::process(const Scan& scan) {
     }
     other = s.shadow->process(scan);
     ++s.trial_frames;
+    ++s.check_frames;
   }
   OdometryResult result = process_frame(scan);
   result.T_world_lidar = s.T_out_own * result.T_world_lidar;
@@ -211,15 +214,14 @@ void Odometry::compare_with_shadow(const Scan& scan, const OdometryResult& own, 
   Impl& s = *impl_;
   const bool deskew = s.trial == Impl::Trial::kDeskew;
   SettingCheck& check = deskew ? s.deskew_check : s.elevation_check;
-  const double speed = s.delta_dt_s > 0 ? s.T_delta.translation().norm() / s.delta_dt_s : 0.0;
   // Only frames in motion tell the two apart. Deskew: at 2 m/s a 0.1 s sweep moves 0.2 m.
   // Elevation: a wrong offset lifts a point by its range times the error, so it shows where a
   // surface is seen from two places at different ranges: 0.2 m between frames.
-  double moved_m = s.delta_dt_s > 0 ? s.T_delta.translation().norm() : 0.0;
+  double moved_m = s.T_delta.translation().norm();
   if (deskew) {
     float t_min = 0, t_max = 0;
     for (const LidarPoint& pt : scan.points) t_min = std::min(t_min, pt.time_s), t_max = std::max(t_max, pt.time_s);
-    moved_m = speed * (t_max - t_min);
+    moved_m = s.delta_dt_s > 0 ? moved_m / s.delta_dt_s * (t_max - t_min) : 0.0;
   }
   const bool solved = !own.degenerate && !other.degenerate && own.mean_residual_m > 0 && other.mean_residual_m > 0;
   // From the shadow's fifth frame: the first ones match maps of one or two scans.
@@ -230,28 +232,27 @@ void Odometry::compare_with_shadow(const Scan& scan, const OdometryResult& own, 
   // median ratio must be 5 % off 1.
   constexpr std::size_t kWindow = 15, kAgree = 13;
   const std::size_t n = s.residual_ratios.size();
+  check.frames_compared = n;
+  if (n > 0)
+    check.residual_ratio = summarize(std::vector<double>(s.residual_ratios.end() - std::min(n, kWindow),
+                                                         s.residual_ratios.end())).median;
   const auto close = [&](const char* verdict) {
     check.verdict = verdict;
-    check.frames_compared = n;
+    check.decided = true;
     check.decided_at_frame = s.first_frame + s.frames - 1;
     (deskew ? s.deskew_open : s.elevation_open) = false;
     s.trial = Impl::Trial::kNone;
     s.shadow.reset();
     std::vector<double>().swap(s.residual_ratios);
   };
-  if (n < kWindow) {
-    // 300 frames and hardly any motion (or times that span nothing): the setting changes
-    // little here, and the second odometry's cost is not worth carrying further.
-    if (s.trial_frames >= 300) close("undecided");
-    return;
-  }
-  const std::vector<double> last(s.residual_ratios.end() - kWindow, s.residual_ratios.end());
-  const auto own_better = static_cast<std::size_t>(std::count_if(last.begin(), last.end(), [](double r) { return r < 1; }));
-  const double ratio = summarize(last).median;
-  check.residual_ratio = ratio;
-  const bool keep = own_better >= kAgree && ratio < 0.95;
-  const bool flip = kWindow - own_better >= kAgree && ratio > 1.05;
-  if (keep || (!flip && n >= 100)) {
+  const auto own_better = static_cast<std::size_t>(
+      std::count_if(s.residual_ratios.end() - std::min(n, kWindow), s.residual_ratios.end(), [](double r) { return r < 1; }));
+  const bool keep = n >= kWindow && own_better >= kAgree && check.residual_ratio < 0.95;
+  const bool flip = n >= kWindow && kWindow - own_better >= kAgree && check.residual_ratio > 1.05;
+  // Undecided after 100 compared frames, or after 300 frames of the check (hardly any motion,
+  // times that span nothing, ratios near 1): the setting changes little here, and the second
+  // odometry's cost is not worth carrying further.
+  if (keep || (!flip && (n >= 100 || s.check_frames >= 300))) {
     close(!keep ? "undecided" : deskew ? "distorted" : "offset");
     return;
   }
@@ -259,7 +260,7 @@ void Odometry::compare_with_shadow(const Scan& scan, const OdometryResult& own, 
   // The other setting fits better. Continue as the shadow, whose world frame is put where this
   // frame was reported; the checks' records (and any check still to run) come along.
   check.verdict = deskew ? "compensated" : "no offset";
-  check.frames_compared = n;
+  check.decided = true;
   check.decided_at_frame = s.first_frame + s.frames - 1;
   (deskew ? s.deskew_open : s.elevation_open) = false;
   const SettingCheck deskew_record = s.deskew_check, elevation_record = s.elevation_check;
@@ -461,6 +462,12 @@ void Odometry::reset_map(
     const std::vector<std::pair<Eigen::Isometry3d, const FeatureCloud*>>& planes_by_pose,
     const Eigen::Isometry3d& T_world_lidar_now) {
   Impl& s = *impl_;
+  // A trial compares two maps grown alike; this one is now rebuilt from the keyframes (thinned,
+  // corrected), the shadow's is not. Its shadow starts again, with the next frame.
+  if (s.shadow) {
+    s.shadow.reset();
+    s.residual_ratios.clear();
+  }
   s.map.clear();
   static const FeatureCloud kEmpty;
   const Eigen::Isometry3d T_own_out = s.T_out_own.inverse();  // the caller's poses in our frame

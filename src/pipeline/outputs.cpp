@@ -137,11 +137,9 @@ nlohmann::json make_summary(const ScanSource& source, const RunResult& result) {
                                          {"last_frame", result.elevation_correction_last_deg}};
   const auto check_json = [](const SettingCheck& check) {
     nlohmann::json out = {{"check", check.verdict}};
-    if (check.frames_compared > 0) {
-      out["decided_at_frame"] = check.decided_at_frame;
-      out["frames_compared"] = check.frames_compared;
-      out["residual_ratio"] = check.residual_ratio;
-    }
+    if (check.decided) out["decided_at_frame"] = check.decided_at_frame;
+    if (check.decided || check.frames_compared > 0) out["frames_compared"] = check.frames_compared;
+    if (check.frames_compared > 0) out["residual_ratio"] = check.residual_ratio;
     return out;
   };
   summary["deskew"] = check_json(result.deskew_check);

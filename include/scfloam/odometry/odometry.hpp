@@ -49,10 +49,11 @@ struct SettingCheck {
   // correction kept), "no offset" (the correction removed), "undecided" (the correction kept).
   // Set when it changes: the odometry's own test is a flag, not this text.
   std::string verdict = "off";
+  bool decided = false;
   std::size_t decided_at_frame = 0;  // frame index of the decision
-  std::size_t frames_compared = 0;   // frames in motion whose two solves were compared
-  // Median over them of the configured way's mean residual / the other way's (deskewed / raw;
-  // corrected / uncorrected).
+  std::size_t frames_compared = 0;   // frames in motion whose two solves were compared (so far)
+  // Median over the last 15 of them of the configured way's mean residual / the other way's
+  // (deskewed / raw; corrected / uncorrected).
   double residual_ratio = 0;
 };
 
