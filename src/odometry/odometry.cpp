@@ -236,11 +236,15 @@ void Odometry::compare_with_shadow(const Scan& scan, const OdometryResult& own, 
   if (n > 0)
     check.residual_ratio = summarize(std::vector<double>(s.residual_ratios.end() - std::min(n, kWindow),
                                                          s.residual_ratios.end())).median;
-  const auto close = [&](const char* verdict) {
+  const auto decide = [&](const char* verdict) {
     check.verdict = verdict;
     check.decided = true;
     check.decided_at_frame = s.first_frame + s.frames - 1;
     (deskew ? s.deskew_open : s.elevation_open) = false;
+  };
+  // Decided, or given up, keeping this odometry's setting.
+  const auto close = [&](const char* verdict) {
+    decide(verdict);
     s.trial = Impl::Trial::kNone;
     s.shadow.reset();
     std::vector<double>().swap(s.residual_ratios);
@@ -257,12 +261,9 @@ void Odometry::compare_with_shadow(const Scan& scan, const OdometryResult& own, 
     return;
   }
   if (!flip) return;
-  // The other setting fits better. Continue as the shadow, whose world frame is put where this
-  // frame was reported; the checks' records (and any check still to run) come along.
-  check.verdict = deskew ? "compensated" : "no offset";
-  check.decided = true;
-  check.decided_at_frame = s.first_frame + s.frames - 1;
-  (deskew ? s.deskew_open : s.elevation_open) = false;
+  // The other setting fits better. Continue as the shadow (world frame below); the checks'
+  // records (and any check still to run) come along.
+  decide(deskew ? "compensated" : "no offset");
   const SettingCheck deskew_record = s.deskew_check, elevation_record = s.elevation_check;
   const bool deskew_open = s.deskew_open, elevation_open = s.elevation_open;
   // The shadow's attitude is the better one since the trial began (this odometry's carries

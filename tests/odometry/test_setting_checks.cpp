@@ -56,63 +56,58 @@ SwitchRun drive_through_switch(
   return run;
 }
 
-TEST(DeskewCheck, CompensatedScansSwitchToTheRawOdometryWithoutAJump) {
+// A short drive on the loops route (seed 23); `calibrated_beams`: an HDL-64E without KITTI's
+// elevation error.
+sim::SimConfig short_drive(std::size_t frames, bool calibrated_beams) {
   sim::SimConfig cfg;
   cfg.route = "loops";
-  cfg.frames = 40;
+  cfg.frames = frames;
   cfg.seed = 23;
+  if (calibrated_beams) cfg.elevation_bias_deg = 0;
+  return cfg;
+}
+
+// The check switched to the shadow at the frame it reports, on a full window of frames that
+// clearly favoured the shadow, without a jump in the reported track.
+void expect_switch(const SettingCheck& check, const SwitchRun& run, const char* verdict) {
+  EXPECT_EQ(check.verdict, verdict);
+  EXPECT_GT(run.switched_at, 5u);
+  EXPECT_EQ(check.decided_at_frame, run.switched_at);
+  EXPECT_GT(check.residual_ratio, 1.05);
+  EXPECT_GE(check.frames_compared, 15u);
+  std::printf("  switched at frame %zu, worst step error %.4f m\n", run.switched_at, run.worst_step_error_m);
+  EXPECT_LT(run.worst_step_error_m, 0.03) << "switched at frame " << run.switched_at;
+}
+
+TEST(DeskewCheck, CompensatedScansSwitchToTheRawOdometryWithoutAJump) {
   OdometryConfig config;
   config.preprocess.deskew = true;  // the scans carry times, but are compensated (KITTI-like)
   Odometry odometry(config);
   EXPECT_EQ(odometry.deskew_check().verdict, "off");  // nothing seen yet
-  const SwitchRun run = drive_through_switch(cfg, odometry, [](const Odometry& o) {
+  const SwitchRun run = drive_through_switch(short_drive(40, false), odometry, [](const Odometry& o) {
     return o.deskew_check().verdict == "compensated";
   });
-  const SettingCheck& check = odometry.deskew_check();
-  EXPECT_EQ(check.verdict, "compensated");
-  EXPECT_GT(run.switched_at, 5u);
-  EXPECT_EQ(check.decided_at_frame, run.switched_at);
-  EXPECT_GT(check.residual_ratio, 1.05);
-  EXPECT_GE(check.frames_compared, 15u);
-  std::printf("  switched at frame %zu, worst step error %.4f m\n", run.switched_at, run.worst_step_error_m);
   // Measured: 1.5 cm at worst; without putting the raw odometry's world frame where the
   // switch frame was reported, the switch step alone errs by 5.5 cm.
-  EXPECT_LT(run.worst_step_error_m, 0.03) << "switched at frame " << run.switched_at;
+  expect_switch(odometry.deskew_check(), run, "compensated");
 }
 
 // Calibrated HDL-64E beams, run with KITTI's correction: the odometry continues without it.
 TEST(ElevationCheck, CalibratedBeamsSwitchToTheUncorrectedOdometryWithoutAJump) {
-  sim::SimConfig cfg;
-  cfg.route = "loops";
-  cfg.frames = 40;
-  cfg.seed = 23;
-  cfg.elevation_bias_deg = 0;
-  OdometryConfig config;  // KITTI's 0.22 deg
-  Odometry odometry(config);
+  Odometry odometry(OdometryConfig{});  // KITTI's 0.22 deg
   EXPECT_EQ(odometry.elevation_check().verdict, "off");  // nothing seen yet
-  const SwitchRun run = drive_through_switch(cfg, odometry, [](const Odometry& o) {
+  const SwitchRun run = drive_through_switch(short_drive(40, true), odometry, [](const Odometry& o) {
     return o.elevation_check().verdict == "no offset";
   });
-  const SettingCheck& check = odometry.elevation_check();
-  EXPECT_EQ(check.verdict, "no offset");
-  EXPECT_GT(run.switched_at, 5u);
-  EXPECT_EQ(check.decided_at_frame, run.switched_at);
-  EXPECT_GT(check.residual_ratio, 1.05);
-  EXPECT_GE(check.frames_compared, 15u);
+  expect_switch(odometry.elevation_check(), run, "no offset");
   EXPECT_EQ(odometry.deskew_check().verdict, "off");
-  std::printf("  switched at frame %zu, worst step error %.4f m\n", run.switched_at, run.worst_step_error_m);
-  EXPECT_LT(run.worst_step_error_m, 0.03) << "switched at frame " << run.switched_at;
 }
 
 // Both checks configured: the deskew check runs first (whether the scans are distorted
 // changes every residual the elevation check compares), then the elevation check, in the
 // odometry the first one chose; the frames keep their index in the decisions.
 TEST(ElevationCheck, WaitsForTheDeskewCheckThenRunsInTheOdometryItChose) {
-  sim::SimConfig cfg;
-  cfg.route = "loops";
-  cfg.frames = 50;  // two trials: the second decides at ~frame 39
-  cfg.seed = 23;
-  cfg.elevation_bias_deg = 0;
+  const sim::SimConfig cfg = short_drive(50, true);  // two trials: the second decides at ~frame 39
   OdometryConfig config;
   config.preprocess.deskew = true;  // the scans carry times, but are compensated
   Odometry odometry(config);
@@ -134,11 +129,7 @@ TEST(ElevationCheck, WaitsForTheDeskewCheckThenRunsInTheOdometryItChose) {
 // A loop closure rebuilds the odometry's map from keyframes during a trial: the two maps are no
 // longer grown alike, so the shadow starts again rather than compare against a thinned map.
 TEST(ElevationCheck, AMapRebuiltDuringTheTrialStartsTheShadowAgain) {
-  sim::SimConfig cfg;
-  cfg.route = "loops";
-  cfg.frames = 50;  // the restarted trial decides at ~frame 30
-  cfg.seed = 23;
-  cfg.elevation_bias_deg = 0;
+  const sim::SimConfig cfg = short_drive(50, true);  // the restarted trial decides at ~frame 30
   Odometry odometry(OdometryConfig{});
   std::vector<Eigen::Isometry3d> poses;
   std::vector<FeatureCloud> edges, planes;
