@@ -171,12 +171,17 @@ class Placer {
   void tree(Rng& rng, const Vec2& p) {
     const double g = ground(p), trunk_h = rng.uniform(2.2, 3.5);
     const double rxy = rng.uniform(1.5, 3.5), rz = rng.uniform(1.5, 3.0);
-    w_.primitives.push_back(make_cylinder(p.x(), p.y(), rng.uniform(0.12, 0.3), g - 1, g + trunk_h + 1.5 * rz,
-                                          SurfaceKind::trunk, static_cast<float>(rng.uniform(0.25, 0.4))));
-    w_.primitives.push_back(make_ellipsoid(p.x() + rng.uniform(-0.3, 0.3), p.y() + rng.uniform(-0.3, 0.3),
-                                           g + trunk_h + rz, rxy, rz, SurfaceKind::vegetation,
-                                           static_cast<float>(rng.uniform(0.35, 0.6)),
-                                           static_cast<float>(rng.uniform(0.5, 1.5))));
+    // One draw per statement (see rng.hpp); this order keeps the worlds of earlier versions.
+    const float trunk_refl = static_cast<float>(rng.uniform(0.25, 0.4));
+    const double trunk_r = rng.uniform(0.12, 0.3);
+    w_.primitives.push_back(make_cylinder(p.x(), p.y(), trunk_r, g - 1, g + trunk_h + 1.5 * rz,
+                                          SurfaceKind::trunk, trunk_refl));
+    const float free_path = static_cast<float>(rng.uniform(0.5, 1.5));
+    const float crown_refl = static_cast<float>(rng.uniform(0.35, 0.6));
+    const double dy = rng.uniform(-0.3, 0.3);
+    const double dx = rng.uniform(-0.3, 0.3);
+    w_.primitives.push_back(make_ellipsoid(p.x() + dx, p.y() + dy, g + trunk_h + rz, rxy, rz,
+                                           SurfaceKind::vegetation, crown_refl, free_path));
     ++stats_.trees;
   }
 
@@ -189,8 +194,9 @@ class Placer {
     } else {
       const double len = rng.uniform(3.9, 4.9), half_w = rng.uniform(0.85, 0.95);
       add_box(c, t, len / 2, half_w, g + 0.3, g + rng.uniform(0.85, 1.0), SurfaceKind::car, refl);
-      add_box(c - t * 0.2, t, len * rng.uniform(0.24, 0.3), half_w - 0.08, g + 0.9,
-              g + rng.uniform(1.4, 1.6), SurfaceKind::car, refl);
+      const double cabin_top = g + rng.uniform(1.4, 1.6);
+      const double cabin_half_len = len * rng.uniform(0.24, 0.3);
+      add_box(c - t * 0.2, t, cabin_half_len, half_w - 0.08, g + 0.9, cabin_top, SurfaceKind::car, refl);
     }
     // Wheels: the gap under the body is what a low beam sees.
     const Vec2 n(-t.y(), t.x());
@@ -210,7 +216,9 @@ class Placer {
   void sign(Rng& rng, const Vec2& p, const Vec2& t) {
     const double g = ground(p), h = rng.uniform(2.2, 3.0);
     w_.primitives.push_back(make_cylinder(p.x(), p.y(), 0.035, g - 1, g + h, SurfaceKind::pole, 0.35f));
-    add_box(p, t, rng.uniform(0.3, 0.45), 0.02, g + h - rng.uniform(0.5, 0.8), g + h + 0.05, SurfaceKind::sign, 0.9f);
+    const double plate_bottom = g + h - rng.uniform(0.5, 0.8);
+    const double plate_half_w = rng.uniform(0.3, 0.45);
+    add_box(p, t, plate_half_w, 0.02, plate_bottom, g + h + 0.05, SurfaceKind::sign, 0.9f);
     ++stats_.signs;
   }
 
@@ -250,7 +258,9 @@ class Placer {
           }
           const int trees = static_cast<int>(width * 20 / 70) + rng.uniform_int(0, 2);
           for (int i = 0; i < trees; ++i) {
-            const Vec2 q = p + t * rng.uniform(-width / 2, width / 2) + n * (front + rng.uniform(2, 25));
+            const double out = front + rng.uniform(2, 25);
+            const double along = rng.uniform(-width / 2, width / 2);
+            const Vec2 q = p + t * along + n * out;
             if (edge(q) > min_edge + 1.5) tree(rng, q);
           }
         } else {
@@ -290,7 +300,11 @@ class Placer {
           if (rng.chance(0.5))
             w_.primitives.push_back(make_cylinder(q.x(), q.y(), rng.uniform(0.1, 0.3), g - 0.5, g + h, SurfaceKind::pole, 0.3f));
           else
-            add_box(q, t, rng.uniform(0.25, 0.5), rng.uniform(0.25, 0.4), g - 0.5, g + h, SurfaceKind::wall, 0.25f);
+          {
+            const double half_y = rng.uniform(0.25, 0.4);
+            const double half_x = rng.uniform(0.25, 0.5);
+            add_box(q, t, half_x, half_y, g - 0.5, g + h, SurfaceKind::wall, 0.25f);
+          }
         }
       }
       // Parked cars along the curb, kept clear of intersections and lanes.

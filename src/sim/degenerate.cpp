@@ -87,6 +87,18 @@ Scenario tunnel(std::uint64_t seed, std::size_t frames, double mount) {
 }
 
 // ---- open field: a village, open ground with a few far barns and trees, a village ---------
+// A farm building turned at random, half extents and height drawn from [lo, hi] ranges. One
+// draw per statement (rng.hpp), in the order that keeps earlier versions' scenes.
+Primitive farm_building(Rng& rng, double x, double y, double ground, std::pair<double, double> half_x,
+                        std::pair<double, double> half_y, std::pair<double, double> height) {
+  const float reflectance = static_cast<float>(rng.uniform(0.2, 0.5));
+  const double top = ground + rng.uniform(height.first, height.second);
+  const double hy = rng.uniform(half_y.first, half_y.second);
+  const double hx = rng.uniform(half_x.first, half_x.second);
+  const double yaw = rng.uniform(0, M_PI);
+  return make_box(x, y, yaw, hx, hy, ground - 1, top, SurfaceKind::wall, reflectance);
+}
+
 Scenario open_field(std::uint64_t seed, std::size_t frames, double mount) {
   // The villages at both ends give the odometry its speed before the field and structure to
   // recover on after it, as the streets around the tunnel do.
@@ -117,8 +129,7 @@ Scenario open_field(std::uint64_t seed, std::size_t frames, double mount) {
     for (const double side : {-1.0, 1.0}) {
       for (double x = x0 + rng.uniform(0, 8); x < x0 + kYard + 30; x += rng.uniform(8, 14)) {
         const double yo = lane_y(x) + side * rng.uniform(8, 16), g = terrain.sample(x, yo);
-        sc.world.primitives.push_back(make_box(x, yo, rng.uniform(0, M_PI), rng.uniform(2, 4), rng.uniform(3, 6), g - 1,
-                                               g + rng.uniform(3, 8), SurfaceKind::wall, static_cast<float>(rng.uniform(0.2, 0.5))));
+        sc.world.primitives.push_back(farm_building(rng, x, yo, g, {2, 4}, {3, 6}, {3, 8}));
         ++sc.stats.buildings;
       }
     }
@@ -128,17 +139,21 @@ Scenario open_field(std::uint64_t seed, std::size_t frames, double mount) {
     const double yo = lane_y(xo) + side * rng.uniform(45, 110);
     const double g = terrain.sample(xo, yo);
     if (rng.chance(0.5)) {  // a barn
-      sc.world.primitives.push_back(make_box(xo, yo, rng.uniform(0, M_PI), rng.uniform(4, 6), rng.uniform(7, 12), g - 1,
-                                             g + rng.uniform(5, 8), SurfaceKind::wall, static_cast<float>(rng.uniform(0.2, 0.5))));
+      sc.world.primitives.push_back(farm_building(rng, xo, yo, g, {4, 6}, {7, 12}, {5, 8}));
       ++sc.stats.buildings;
     } else {  // a group of trees
       for (int i = rng.uniform_int(3, 5); i > 0; --i) {
         const double tx = xo + rng.uniform(-10, 10), ty = yo + rng.uniform(-10, 10), tg = terrain.sample(tx, ty);
         const double height = rng.uniform(6, 10);
-        sc.world.primitives.push_back(make_cylinder(tx, ty, rng.uniform(0.15, 0.3), tg - 0.5, tg + 0.5 * height,
-                                                    SurfaceKind::trunk, static_cast<float>(rng.uniform(0.25, 0.4))));
-        sc.world.primitives.push_back(make_ellipsoid(tx, ty, tg + 0.7 * height, rng.uniform(2, 3.5), 0.3 * height,
-                                                     SurfaceKind::vegetation, static_cast<float>(rng.uniform(0.35, 0.6)), 1.0f));
+        // One draw per statement (rng.hpp), in the order that keeps earlier versions' scenes.
+        const float trunk_refl = static_cast<float>(rng.uniform(0.25, 0.4));
+        const double trunk_r = rng.uniform(0.15, 0.3);
+        sc.world.primitives.push_back(make_cylinder(tx, ty, trunk_r, tg - 0.5, tg + 0.5 * height,
+                                                    SurfaceKind::trunk, trunk_refl));
+        const float crown_refl = static_cast<float>(rng.uniform(0.35, 0.6));
+        const double crown_r = rng.uniform(2, 3.5);
+        sc.world.primitives.push_back(make_ellipsoid(tx, ty, tg + 0.7 * height, crown_r, 0.3 * height,
+                                                     SurfaceKind::vegetation, crown_refl, 1.0f));
         ++sc.stats.trees;
       }
     }

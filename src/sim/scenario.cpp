@@ -150,8 +150,12 @@ Scenario make_loops_scenario(std::uint64_t seed, std::size_t frames, double moun
   const Eigen::Rotation2Dd R(rot);
   std::map<std::pair<int, int>, Vec2> node;
   for (int i = i_min; i <= i_max; ++i)
-    for (int j = j_min; j <= j_max; ++j)
-      node[{i, j}] = R * Vec2(col_x[i] + rng.uniform(-0.08, 0.08) * block, row_y[j] + rng.uniform(-0.08, 0.08) * block);
+    for (int j = j_min; j <= j_max; ++j) {
+      // One draw per statement (rng.hpp), in the order that keeps earlier versions' cities.
+      const double dy = rng.uniform(-0.08, 0.08) * block;
+      const double dx = rng.uniform(-0.08, 0.08) * block;
+      node[{i, j}] = R * Vec2(col_x[i] + dx, row_y[j] + dy);
+    }
 
   // Streets: every grid edge; avenues are wider along a whole grid line.
   std::map<int, double> col_hw, row_hw;
@@ -240,8 +244,11 @@ Scenario make_straight_scenario(std::uint64_t seed, std::size_t frames, double m
     const std::size_t i = std::min(avenue.size() - 2, static_cast<std::size_t>(s / 5));
     const Vec2 t = (avenue[i + 1] - avenue[i]).normalized(), n(-t.y(), t.x());
     for (int side = -1; side <= 1; side += 2)
-      if (rng.chance(0.7))
-        streets.push_back(random_street(rng, {avenue[i], avenue[i] + side * n * rng.uniform(60, 150)}, rng.uniform(5.5, 7)));
+      if (rng.chance(0.7)) {
+        const double half_width = rng.uniform(5.5, 7);
+        const double street_len = rng.uniform(60, 150);
+        streets.push_back(random_street(rng, {avenue[i], avenue[i] + side * n * street_len}, half_width));
+      }
   }
   Scenario sc;
   sc.world = build_city(streets, make_rolling_terrain(bounds_of(streets, 80), seed, 0.04), seed, &sc.stats);
@@ -281,7 +288,9 @@ Scenario make_replay_scenario(const PoseList& T_lidar0_lidar, std::uint64_t seed
       if (rng.chance(0.6)) {
         const double a = rng.uniform(-0.35, 0.35);
         const Vec2 dir = Eigen::Rotation2Dd(a) * (side * n);
-        streets.push_back(random_street(rng, {path[i], path[i] + dir * rng.uniform(60, 150)}, rng.uniform(5.5, 7)));
+        const double half_width = rng.uniform(5.5, 7);
+        const double street_len = rng.uniform(60, 150);
+        streets.push_back(random_street(rng, {path[i], path[i] + dir * street_len}, half_width));
       }
   }
   Scenario sc;

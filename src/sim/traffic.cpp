@@ -149,7 +149,8 @@ Traffic::Traffic(const SampledTrajectory& ego, const World& world, const Traffic
       m.t_on_s = t;
       m.t_off_s = t + 25;
       m.s0_m = ego_arclength(t) + rng.uniform(-20, 60);
-      m.speed_mps = rng.uniform(0.9, 1.6) * (rng.chance(0.5) ? 1 : -1);
+      m.speed_mps = rng.uniform(0.9, 1.6);  // one draw per statement (rng.hpp)
+      if (!rng.chance(0.5)) m.speed_mps = -m.speed_mps;
       const double side = rng.chance(0.5) ? 1.0 : -1.0;
       Vec2 p, h;
       ego_path_.at(m.s0_m, &p, &h);

@@ -44,13 +44,16 @@ struct OwnedCloud {
 inline void put_value(std::uint8_t* p, std::uint8_t type, double v, bool big_endian) {
   std::uint8_t b[8];
   std::size_t n = point_field_size(type);
+  // Integer fields wrap as a driver's would (a ring of -1 in a uint16 field is 65535): through
+  // int64, since a double outside the target type's range is undefined behaviour to convert.
+  const std::int64_t i = std::isfinite(v) ? static_cast<std::int64_t>(v) : 0;
   switch (type) {
-    case 1: { auto x = static_cast<std::int8_t>(v); std::memcpy(b, &x, 1); break; }
-    case 2: { auto x = static_cast<std::uint8_t>(v); std::memcpy(b, &x, 1); break; }
-    case 3: { auto x = static_cast<std::int16_t>(v); std::memcpy(b, &x, 2); break; }
-    case 4: { auto x = static_cast<std::uint16_t>(v); std::memcpy(b, &x, 2); break; }
-    case 5: { auto x = static_cast<std::int32_t>(v); std::memcpy(b, &x, 4); break; }
-    case 6: { auto x = static_cast<std::uint32_t>(v); std::memcpy(b, &x, 4); break; }
+    case 1: { auto x = static_cast<std::int8_t>(i); std::memcpy(b, &x, 1); break; }
+    case 2: { auto x = static_cast<std::uint8_t>(i); std::memcpy(b, &x, 1); break; }
+    case 3: { auto x = static_cast<std::int16_t>(i); std::memcpy(b, &x, 2); break; }
+    case 4: { auto x = static_cast<std::uint16_t>(i); std::memcpy(b, &x, 2); break; }
+    case 5: { auto x = static_cast<std::int32_t>(i); std::memcpy(b, &x, 4); break; }
+    case 6: { auto x = static_cast<std::uint32_t>(i); std::memcpy(b, &x, 4); break; }
     case 7: { auto x = static_cast<float>(v); std::memcpy(b, &x, 4); break; }
     default: { std::memcpy(b, &v, 8); break; }
   }

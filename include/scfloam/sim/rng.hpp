@@ -1,5 +1,9 @@
 // Portable, seedable random numbers for the simulator. std:: distributions are
 // implementation-defined; these are not, so a seed gives the same world everywhere.
+// That also needs one draw per statement (or per declarator): C++ leaves the order in which
+// a call's arguments or an operator's operands are evaluated unspecified, so two draws in
+// `f(rng.uniform(), rng.uniform())` come in one order under gcc and the other under clang.
+// scripts/test.sh compares the two compilers' simulated sequences byte for byte.
 #pragma once
 
 #include <cmath>
