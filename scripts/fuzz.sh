@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Fuzzes every reader: builds build-fuzz (clang, libFuzzer + ASan + UBSan) and runs each
-# fuzz/<name>_fuzz target for SECONDS_PER_TARGET seconds (default 10).
+# Fuzzes every reader: builds build-fuzz (clang, libFuzzer + ASan + UBSan; SCFLOAM_FUZZ_BUILD
+# names another tree) and runs each fuzz/<name>_fuzz target for SECONDS_PER_TARGET seconds
+# (default 10).
 # Usage: scripts/fuzz.sh [SECONDS_PER_TARGET] [TARGET...]
 #
 # Two uses:
@@ -33,10 +34,14 @@ if [ ${#targets[@]} -eq 0 ]; then
   for f in fuzz/*_fuzz.cpp; do targets+=("$(basename "$f" _fuzz.cpp)"); done
 fi
 
-cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \
-  -DSCFLOAM_FUZZ=ON -DSCFLOAM_BUILD_TESTS=OFF -DSCFLOAM_BUILD_BENCH=OFF \
-  -DSCFLOAM_SHARED_DIR="$shared" >"$build.configure.log" 2>&1 ||
-  { cat "$build.configure.log"; exit 1; }
+# A tree already configured for fuzzing (scripts/test.sh's build-asan, which also holds the
+# sanitizer tests) is used as it is; otherwise a fuzz-only tree is configured.
+if ! grep -q '^SCFLOAM_FUZZ:BOOL=ON' "$build/CMakeCache.txt" 2>/dev/null; then
+  cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \
+    -DSCFLOAM_FUZZ=ON -DSCFLOAM_BUILD_TESTS=OFF -DSCFLOAM_BUILD_BENCH=OFF \
+    -DSCFLOAM_SHARED_DIR="$shared" >"$build.configure.log" 2>&1 ||
+    { cat "$build.configure.log"; exit 1; }
+fi
 cmake --build "$build" -j"$(nproc)" --target "${targets[@]/%/_fuzz}"
 
 # Real files (cut to a few KB, or the smallest bags), so that the fuzzer starts from inputs
