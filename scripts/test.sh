@@ -53,18 +53,8 @@ stage "asan-build" cmake --build "$asan" -j"$jobs"
 export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1:strict_string_checks=1:${ASAN_OPTIONS:-}"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:${UBSAN_OPTIONS:-}"
 
-# A seed gives the same simulated sequence on every compiler: the gcc and clang builds'
-# digests of worlds, trajectories, traffic and scans must be equal (tests/support/sim_digest.cpp).
-compare_simulators() {
-  "$build/bin/sim_digest" "$shared" >"$asan.sim-digest-gcc.txt"
-  "$asan/bin/sim_digest" "$shared" >"$asan.sim-digest-clang.txt"
-  if ! diff "$asan.sim-digest-gcc.txt" "$asan.sim-digest-clang.txt"; then
-    echo "error: the gcc and clang builds simulate different sequences for the same seed (above: < gcc, > clang)" >&2
-    return 1
-  fi
-  echo "sim-digest: $(wc -l <"$asan.sim-digest-gcc.txt") configurations identical under gcc and clang"
-}
-stage "sim-compilers" compare_simulators
+# A seed gives the same simulated sequence on every compiler (gcc here, clang there).
+stage "sim-compilers" bash scripts/compare_simulators.sh "$build" "$asan" "$shared"
 stage "asan-ctest" ctest --test-dir "$asan" --output-on-failure -j"$jobs" --timeout 1800 -LE long
 
 # The fuzzers come from the same tree. A fixed seed: a CI failure is re-run with the command
