@@ -5,16 +5,17 @@
 # Usage: scripts/fuzz.sh [SECONDS_PER_TARGET] [TARGET...]
 #
 # Two uses:
-# - CI (scripts/test.sh sets SCFLOAM_FUZZ_SEED=1): reproducible. libFuzzer runs with -seed=N and
-#   starts from a fresh corpus holding only the seeds (build-fuzz/fuzz-corpus-seed/<name>/,
-#   emptied first), so what it tries depends on the sources, ../shared and N alone: a failed CI
-#   run is re-run with the command the summary prints (given at least as many seconds).
+# - CI (scripts/test.sh sets SCFLOAM_FUZZ_SEED=1 and SCFLOAM_FUZZ_BUILD=build-asan): reproducible.
+#   libFuzzer runs with -seed=N and starts from a fresh corpus holding only the seeds
+#   (<tree>/fuzz-corpus-seed/<name>/, emptied first), so what it tries depends on the sources,
+#   the build tree's flags, ../shared and N alone: a failed CI run is re-run with the command
+#   the summary prints (given at least as many seconds).
 # - Bench (`bash scripts/fuzz.sh 300`, no SCFLOAM_FUZZ_SEED): libFuzzer picks the seed (printed
-#   in the summary) and the corpus keeps growing in build-fuzz/fuzz-corpus/<name>/ between runs.
+#   in the summary) and the corpus keeps growing in <tree>/fuzz-corpus/<name>/ between runs.
 #   Results: docs/robustness.md.
 # Seeds: fuzz/corpus/<name>/ plus samples cut at run time from ../shared/data and config/.
 # Before fuzzing, every saved crash input (tests/io/fuzz_regressions/<name>/) is replayed once.
-# A crash leaves its input in build-fuzz/fuzz-crashes/<name>/ and makes this script fail:
+# A crash leaves its input in <tree>/fuzz-crashes/<name>/ and makes this script fail:
 # fix the reader and copy the input to tests/io/fuzz_regressions/<name>/ (replayed by test_io).
 set -euo pipefail
 seconds="${1:-10}"
@@ -36,7 +37,8 @@ fi
 
 # A tree already configured for fuzzing (scripts/test.sh's build-asan, which also holds the
 # sanitizer tests) is used as it is; otherwise a fuzz-only tree is configured.
-if ! grep -q '^SCFLOAM_FUZZ:BOOL=ON' "$build/CMakeCache.txt" 2>/dev/null; then
+if ! grep -q '^SCFLOAM_FUZZ:BOOL=ON' "$build/CMakeCache.txt" 2>/dev/null ||
+   { [ ! -f "$build/Makefile" ] && [ ! -f "$build/build.ninja" ]; }; then
   cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \
     -DSCFLOAM_FUZZ=ON -DSCFLOAM_BUILD_TESTS=OFF -DSCFLOAM_BUILD_BENCH=OFF \
     -DSCFLOAM_SHARED_DIR="$shared" >"$build.configure.log" 2>&1 ||
@@ -138,6 +140,6 @@ for name in "${targets[@]}"; do
 done
 cat "$summary"
 if [ "$failed" = 1 ] && [ -n "$seed" ]; then
-  echo "fuzz: to re-run this exactly: SCFLOAM_FUZZ_SEED=$seed bash scripts/fuzz.sh $seconds ${targets[*]}"
+  echo "fuzz: to re-run this exactly: SCFLOAM_FUZZ_BUILD=$build SCFLOAM_FUZZ_SEED=$seed bash scripts/fuzz.sh $seconds ${targets[*]}"
 fi
 exit $failed

@@ -42,7 +42,8 @@ if [ "${SCFLOAM_SKIP_SANITIZERS:-0}" = 1 ]; then cat "$stages"; exit 0; fi
 # libFuzzer's coverage instrumentation. -O1 with -g1 (function names and lines in reports, no
 # variable info) builds far cheaper than -O2 -g; benchmarks are not built. A tree left by an
 # older version of this script (gcc) is rebuilt from scratch.
-if [ -f "$asan/CMakeCache.txt" ] && ! grep -q '^CMAKE_CXX_COMPILER:[A-Z]*=.*clang' "$asan/CMakeCache.txt"; then
+if [ "$asan" != "$build" ] && [ -f "$asan/CMakeCache.txt" ] &&
+   ! grep -q '^CMAKE_CXX_COMPILER:[A-Z]*=.*clang' "$asan/CMakeCache.txt"; then
   rm -rf "$asan"
 fi
 cmake -S . -B "$asan" -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \

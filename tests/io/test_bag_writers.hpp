@@ -46,7 +46,7 @@ inline void put_value(std::uint8_t* p, std::uint8_t type, double v, bool big_end
   std::size_t n = point_field_size(type);
   // Integer fields wrap as a driver's would (a ring of -1 in a uint16 field is 65535): through
   // int64, since a double outside the target type's range is undefined behaviour to convert.
-  const std::int64_t i = std::isfinite(v) ? static_cast<std::int64_t>(v) : 0;
+  const std::int64_t i = std::isfinite(v) ? static_cast<std::int64_t>(std::clamp(v, -9e18, 9e18)) : 0;
   switch (type) {
     case 1: { auto x = static_cast<std::int8_t>(i); std::memcpy(b, &x, 1); break; }
     case 2: { auto x = static_cast<std::uint8_t>(i); std::memcpy(b, &x, 1); break; }

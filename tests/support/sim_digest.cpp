@@ -99,6 +99,7 @@ SimConfig config(const std::string& route, std::uint64_t seed, std::size_t frame
 int main(int argc, char** argv) {
   const fs::path shared = argc > 1 ? fs::path(argv[1]) : fs::path();
   const fs::path replay = shared / "data/kitti/ground-truth/poses/05.txt";
+  const fs::path tmp = fs::temp_directory_path() / ("scfloam-sim-digest-" + std::to_string(::getpid()));
   try {
     // Worlds: the route kinds and every degenerate scene, several seeds.
     for (std::uint64_t seed = 1; seed <= 3; ++seed)
@@ -112,14 +113,15 @@ int main(int argc, char** argv) {
         std::printf("world %s seed %llu: %s\n", scene.c_str(), static_cast<unsigned long long>(seed),
                     scenario_digest(c).c_str());
       }
-    if (!shared.empty() && fs::exists(replay)) {
+    if (shared.empty() || !fs::exists(replay)) {
+      std::printf("world kitti-05 replay: skipped (no %s)\n", replay.c_str());
+    } else {
       SimConfig c = config("kitti", 3, 200);
       c.replay_poses = replay;
       std::printf("world kitti-05 replay: %s\n", scenario_digest(c).c_str());
     }
     // Scans: two frames of a 64- and a 16-beam sensor, and of a motion-distorted 32-beam one
     // written as PCD with per-point times.
-    const fs::path tmp = fs::temp_directory_path() / ("scfloam-sim-digest-" + std::to_string(::getpid()));
     for (const std::string& sensor : {std::string("hdl64"), std::string("vlp16")}) {
       SimConfig c = config("loops", 5, 2);
       c.sensor = sensor;
@@ -131,6 +133,8 @@ int main(int argc, char** argv) {
     distorted.scan_format = "pcd";
     std::printf("scans hdl32 distorted pcd: %s\n", sequence_digest(distorted, tmp).c_str());
   } catch (const std::exception& e) {
+    std::error_code ec;
+    fs::remove_all(tmp, ec);
     std::fprintf(stderr, "sim_digest: %s\n", e.what());
     return 1;
   }
