@@ -297,10 +297,9 @@ class Placer {
           sign(rng, q, t);
         } else {
           const double g = ground(q), h = rng.uniform(0.4, 1.2);
-          if (rng.chance(0.5))
+          if (rng.chance(0.5)) {
             w_.primitives.push_back(make_cylinder(q.x(), q.y(), rng.uniform(0.1, 0.3), g - 0.5, g + h, SurfaceKind::pole, 0.3f));
-          else
-          {
+          } else {
             const double half_y = rng.uniform(0.25, 0.4);
             const double half_x = rng.uniform(0.25, 0.5);
             add_box(q, t, half_x, half_y, g - 0.5, g + h, SurfaceKind::wall, 0.25f);
