@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <vector>
 
 #include "scfloam/io/kitti.hpp"
 #include "scfloam/odometry/odometry.hpp"
@@ -16,6 +17,7 @@ struct FrameErrors {
   double max_translation_m = 0;
   double max_horizontal_m = 0;  // x, y of the lidar frame
   double max_rotation_deg = 0;
+  std::vector<Eigen::Isometry3d> steps;  // estimated motion from frame i-1 to i (index i-1)
 };
 
 // Runs the odometry over the frames (in reverse order when `backwards`) and compares each
@@ -43,6 +45,7 @@ FrameErrors run_sequence(const std::filesystem::path& dir, bool backwards = fals
     e.max_translation_m = std::max(e.max_translation_m, t);
     e.max_horizontal_m = std::max(e.max_horizontal_m, err.translation().head<2>().norm());
     e.max_rotation_deg = std::max(e.max_rotation_deg, r);
+    e.steps.push_back(d_est);
   }
   return e;
 }
@@ -66,6 +69,28 @@ TEST(RealKitti, Sequence08HorizontallyWithin6cmAnd0p1deg) {
               e.max_horizontal_m);
   EXPECT_LE(e.max_horizontal_m, 0.06);
   EXPECT_LE(e.max_rotation_deg, 0.1);
+}
+
+// Is 08's horizontal miss from our map or our prediction? Driven backwards, each step is
+// estimated from another map (the thin-map start is at frame 9) and another prediction.
+// Measured: the two estimates of every step at most 1.3 cm apart, against 5.6 cm from the
+// ground truth, whose steps jitter while ours are smooth. Not excluded by this: a bias that
+// both directions share, from the scans themselves (over frames 1-9 both estimates sum to
+// 6.40 m of forward motion, the ground truth to 6.59 m).
+TEST(RealKitti, Sequence08BackwardsAgreesWithForwards) {
+  SCFLOAM_SHARED_DATA_OR_SKIP(dir, "kitti/scans/08");
+  const FrameErrors forwards = run_sequence(dir), backwards = run_sequence(dir, true);
+  ASSERT_EQ(forwards.steps.size(), backwards.steps.size());
+  double worst_m = 0, worst_deg = 0;
+  for (std::size_t i = 0; i < forwards.steps.size(); ++i) {
+    const Eigen::Isometry3d d = forwards.steps[i].inverse() * backwards.steps[i];
+    worst_m = std::max(worst_m, d.translation().norm());
+    worst_deg = std::max(worst_deg, rotation_angle_rad(d.linear()) * 180.0 / M_PI);
+  }
+  std::printf("  08 forwards vs backwards: steps at most %.4f m and %.4f deg apart; from the ground "
+              "truth %.4f m horizontally\n", worst_m, worst_deg, forwards.max_horizontal_m);
+  EXPECT_LT(worst_m, 0.02);
+  EXPECT_LT(worst_deg, 0.05);
 }
 
 // 00's first frames carry a known ground-truth offset: report the errors, bound them loosely.
