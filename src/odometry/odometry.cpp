@@ -62,6 +62,9 @@ struct Odometry::Impl {
   bool deskew_open = false, elevation_open = false;  // configured, no verdict yet
   enum class Trial { kNone, kDeskew, kElevation } trial = Trial::kNone;
   std::unique_ptr<Odometry> shadow;
+  // The shadow's result for each frame it has seen: if it wins, they replace the trial's frames
+  // (OdometryResult::revised). ~100 KB of features per frame, for at most 300 frames.
+  std::vector<OdometryResult> shadow_results;
   std::size_t trial_frames = 0;  // frames the shadow has seen
   std::size_t check_frames = 0;  // frames since the running check began (a shadow may restart)
   // The first frame of the trial as reported (this odometry's) and in the shadow's own frame.
@@ -157,6 +160,7 @@ const RingLayoutInfo& Odometry::ring_layout() const { return impl_->extractor.ri
 
 const SettingCheck& Odometry::deskew_check() const { return impl_->deskew_check; }
 const SettingCheck& Odometry::elevation_check() const { return impl_->elevation_check; }
+bool Odometry::trial_running() const { return impl_->trial != Impl::Trial::kNone; }
 
 OdometryResult Odometry::process(const Scan& scan) {
   Impl& s = *impl_;
@@ -192,9 +196,11 @@ OdometryResult Odometry::process(const Scan& scan) {
         s.elevation_check.verdict = "trial";
       }
       s.shadow = std::make_unique<Odometry>(flipped);
+      s.shadow_results.clear();
       s.trial_frames = 0;
     }
     other = s.shadow->process(scan);
+    s.shadow_results.push_back(other);
     ++s.trial_frames;
     ++s.check_frames;
   }
@@ -210,7 +216,7 @@ OdometryResult Odometry::process(const Scan& scan) {
   return result;
 }
 
-void Odometry::compare_with_shadow(const Scan& scan, const OdometryResult& own, const OdometryResult& other) {
+void Odometry::compare_with_shadow(const Scan& scan, OdometryResult& own, const OdometryResult& other) {
   Impl& s = *impl_;
   const bool deskew = s.trial == Impl::Trial::kDeskew;
   SettingCheck& check = deskew ? s.deskew_check : s.elevation_check;
@@ -247,6 +253,7 @@ void Odometry::compare_with_shadow(const Scan& scan, const OdometryResult& own, 
     decide(verdict);
     s.trial = Impl::Trial::kNone;
     s.shadow.reset();
+    std::vector<OdometryResult>().swap(s.shadow_results);
     std::vector<double>().swap(s.residual_ratios);
   };
   const auto own_better = static_cast<std::size_t>(
@@ -266,14 +273,23 @@ void Odometry::compare_with_shadow(const Scan& scan, const OdometryResult& own, 
   decide(deskew ? "compensated" : "no offset");
   const SettingCheck deskew_record = s.deskew_check, elevation_record = s.elevation_check;
   const bool deskew_open = s.deskew_open, elevation_open = s.elevation_open;
-  // The shadow's attitude is the better one since the trial began (this odometry's carries
-  // what the trial frames' setting did to it: with a wrong elevation offset, a tilt that would
-  // stay for the rest of the drive), so its world frame is turned to where this odometry was
-  // at the trial's first frame; its position continues from this frame's, so the reported
-  // track does not jump.
-  Eigen::Isometry3d T_out_other = Eigen::Isometry3d::Identity();
-  T_out_other.linear() = s.trial_start.first.linear() * s.trial_start.second.linear().transpose();
-  T_out_other.translation() = own.T_world_lidar.translation() - T_out_other.linear() * other.T_world_lidar.translation();
+  // The shadow's track is the better one since the trial began (this odometry's carries what
+  // the trial frames' setting did to it: with a wrong elevation offset, a tilt that would stay
+  // for the rest of the drive), so its world frame is put where this odometry was at the
+  // trial's first frame, and its results replace the trial's: the reported track is the one
+  // the winning setting would have made from that frame on, continuous at its start. (Until
+  // session 34 the trial's frames stayed as reported and the position continued from this
+  // frame's; the keyframes cut from them carried the losing setting's features.)
+  const Eigen::Isometry3d T_out_other =
+      orthonormalized(s.trial_start.first * s.trial_start.second.inverse());
+  std::vector<OdometryResult> revised = std::move(s.shadow_results);
+  for (OdometryResult& r : revised) r.T_world_lidar = T_out_other * r.T_world_lidar;
+  OdometryResult switched = std::move(revised.back());  // this frame's
+  revised.pop_back();
+  switched.features_ms = own.features_ms;  // both solves ran on this frame
+  switched.registration_ms = own.registration_ms;
+  switched.revised = std::move(revised);
+  own = std::move(switched);
   // The caller's index of the shadow's first frame (it started with the trial).
   const std::size_t first_frame = s.first_frame + s.frames - s.trial_frames;
   std::unique_ptr<Odometry> shadow = std::move(s.shadow);
@@ -467,6 +483,7 @@ void Odometry::reset_map(
   // corrected), the shadow's is not. Its shadow starts again, with the next frame.
   if (s.shadow) {
     s.shadow.reset();
+    s.shadow_results.clear();
     s.residual_ratios.clear();
   }
   s.map.clear();

@@ -10,6 +10,8 @@
 #include <cstdio>
 #include <exception>
 #include <mutex>
+#include <optional>
+#include <stdexcept>
 #include <thread>
 #include <unordered_set>
 #include <utility>
@@ -235,27 +237,22 @@ class OdometryStage {
         selector_(config.loop_detection.keyframe_distance_m,
                   config.loop_detection.keyframe_angle_deg * M_PI / 180.0) {}
 
-  // Processes one scan; returns the new keyframe, if this scan made one.
-  KeyframePtr process(std::size_t frame, const Scan& scan, RunResult& result) {
-    if (loops_ && store_.version() != seen_version_) {
+  // Processes one scan; returns the keyframes made. While one of the odometry's setting checks
+  // runs, its frames are held (no keyframe, no trajectory yet): if the check switches to the
+  // other setting, that setting's results replace them (OdometryResult::revised), so that
+  // neither the keyframes nor the trajectory carry the setting it dropped. A trial lasts
+  // 2-30 s at the start of a run.
+  std::vector<KeyframePtr> process(std::size_t frame, const Scan& scan, RunResult& result) {
+    // A correction re-anchors the odometry's frame: not while frames in the old one are held.
+    if (loops_ && store_.version() != seen_version_ && held_.empty()) {
       Stopwatch watch;
       reanchor();
       result.timing_ms["map_rebuild"].push_back(watch.elapsed_ms());
     }
-    const OdometryResult odom = odometry_.process(scan);
-    // The odometry's own chain of relative motions: its trajectory before any correction.
-    const Eigen::Isometry3d T_last_current = has_last_ ? T_world_last_.inverse() * odom.T_world_lidar
-                                                       : Eigen::Isometry3d::Identity();
-    T_chain_ = orthonormalized(T_chain_ * T_last_current);
-    T_world_last_ = odom.T_world_lidar;
-    has_last_ = true;
+    OdometryResult odom = odometry_.process(scan);
     result.stamps_s.push_back(scan.timestamp_s);
-    result.odometry_T_world_lidar.push_back(T_chain_);
     result.timing_ms["features"].push_back(odom.features_ms);
     result.timing_ms["registration"].push_back(odom.registration_ms);
-    if (odom.degenerate) ++result.degenerate_frames;
-    if (result.stamps_s.size() == 1) result.elevation_correction_first_deg = odom.elevation_correction_deg;
-    result.elevation_correction_last_deg = odom.elevation_correction_deg;
     result.deskew_check = odometry_.deskew_check();
     result.elevation_check = odometry_.elevation_check();
     if (result.stamps_s.size() == 1 || result.ring_layout.source != odometry_.ring_layout().source)
@@ -264,23 +261,31 @@ class OdometryStage {
     if (result.registration_rounds.size() <= rounds) result.registration_rounds.resize(rounds + 1, 0);
     ++result.registration_rounds[rounds];
 
-    KeyframePtr made;
-    if (selector_.update(T_chain_)) {
-      auto kf = std::make_shared<Keyframe>();
-      kf->index = kf_poses_.size();
-      kf->frame = frame;
-      kf->T_prev_current = kf_poses_.empty() ? Eigen::Isometry3d::Identity()
-                                             : kf_poses_.back().inverse() * odom.T_world_lidar;
-      kf->edges = odom.edges;
-      kf->planes = odom.planes;
-      if (loops_ && !config_.loop_detection.descriptor_from_features)
-        kf->raw = downsampled_raw(scan, config_.pipeline.raw_leaf_m, raw_filter_);
-      kf_poses_.push_back(odom.T_world_lidar);
-      result.keyframe_frames.push_back(frame);
-      store_.add(kf);  // the map is assembled from keyframes in every mode
-      made = kf;
+    if (!odom.revised.empty()) {
+      if (odom.revised.size() > held_.size())
+        throw std::logic_error("the odometry revised frames the pipeline did not hold");
+      const std::size_t first = held_.size() - odom.revised.size();
+      for (std::size_t i = 0; i < odom.revised.size(); ++i) held_[first + i].odom = std::move(odom.revised[i]);
+      odom.revised.clear();
     }
-    anchors_.push_back({kf_poses_.size() - 1, kf_poses_.back().inverse() * odom.T_world_lidar});
+    held_.push_back({frame, std::move(odom), std::nullopt});
+    if (odometry_.trial_running()) {
+      // A held frame's scan is gone by the time it may become a keyframe; the raw cloud does
+      // not depend on the odometry's settings.
+      if (raw_clouds()) held_.back().raw = downsampled_raw(scan, config_.pipeline.raw_leaf_m, raw_filter_);
+      return {};
+    }
+    return flush(result, &scan);
+  }
+
+  // Accepts the held frames; `scan` is the last one's, if it has no raw cloud yet. (At the end
+  // of the input, a trial still running keeps the configured setting's results, as an
+  // undecided check does.)
+  std::vector<KeyframePtr> flush(RunResult& result, const Scan* scan = nullptr) {
+    std::vector<KeyframePtr> made;
+    for (HeldFrame& held : held_)
+      if (KeyframePtr kf = accept(held, result, scan)) made.push_back(std::move(kf));
+    held_.clear();
     return made;
   }
 
@@ -293,6 +298,52 @@ class OdometryStage {
   }
 
  private:
+  struct HeldFrame {
+    std::size_t frame;
+    OdometryResult odom;
+    std::optional<FeatureCloud> raw;  // raw_clouds(): taken while the scan was at hand
+  };
+
+  // Keyframes carry a downsampled raw cloud for raw-scan descriptors (simple-sc).
+  bool raw_clouds() const { return loops_ && !config_.loop_detection.descriptor_from_features; }
+
+  // The frame's pose into the trajectory; returns the keyframe it made, if any.
+  KeyframePtr accept(HeldFrame& held, RunResult& result, const Scan* scan) {
+    OdometryResult& odom = held.odom;
+    // The odometry's own chain of relative motions: its trajectory before any correction.
+    const Eigen::Isometry3d T_last_current = has_last_ ? T_world_last_.inverse() * odom.T_world_lidar
+                                                       : Eigen::Isometry3d::Identity();
+    T_chain_ = orthonormalized(T_chain_ * T_last_current);
+    T_world_last_ = odom.T_world_lidar;
+    has_last_ = true;
+    result.odometry_T_world_lidar.push_back(T_chain_);
+    if (odom.degenerate) ++result.degenerate_frames;
+    if (result.odometry_T_world_lidar.size() == 1) result.elevation_correction_first_deg = odom.elevation_correction_deg;
+    result.elevation_correction_last_deg = odom.elevation_correction_deg;
+
+    KeyframePtr made;
+    if (selector_.update(T_chain_)) {
+      auto kf = std::make_shared<Keyframe>();
+      kf->index = kf_poses_.size();
+      kf->frame = held.frame;
+      kf->T_prev_current = kf_poses_.empty() ? Eigen::Isometry3d::Identity()
+                                             : kf_poses_.back().inverse() * odom.T_world_lidar;
+      kf->edges = std::move(odom.edges);
+      kf->planes = std::move(odom.planes);
+      if (raw_clouds()) {
+        if (held.raw) kf->raw = std::move(*held.raw);
+        else if (scan) kf->raw = downsampled_raw(*scan, config_.pipeline.raw_leaf_m, raw_filter_);
+        else throw std::logic_error("a held keyframe without its raw cloud");
+      }
+      kf_poses_.push_back(odom.T_world_lidar);
+      result.keyframe_frames.push_back(held.frame);
+      store_.add(kf);  // the map is assembled from keyframes in every mode
+      made = kf;
+    }
+    anchors_.push_back({kf_poses_.size() - 1, kf_poses_.back().inverse() * odom.T_world_lidar});
+    return made;
+  }
+
   // The graph moved the keyframes: move the odometry's frame with them and rebuild its local
   // map from the corrected keyframes around the current position.
   void reanchor() {
@@ -369,6 +420,7 @@ class OdometryStage {
   Eigen::Vector3d last_rebuild_position_ = Eigen::Vector3d::Constant(1e9);
   Eigen::Isometry3d T_chain_ = Eigen::Isometry3d::Identity();
   bool has_last_ = false;
+  std::vector<HeldFrame> held_;  // frames of a running setting check, oldest first
 };
 
 }  // namespace
@@ -410,6 +462,20 @@ RunResult run_slam(const ScanSource& source, const SlamConfig& base_config,
   std::vector<double>& wait_input_ms = result.timing_ms["wait_input"];
   std::vector<double>& wait_queue_ms = result.timing_ms["wait_loop_queue"];
   std::vector<double>& wait_lag_ms = result.timing_ms["wait_loop_lag"];
+  // A keyframe goes to the loop stages (their threads, or at once when deterministic).
+  const auto hand_over = [&](KeyframePtr kf) {
+    if (options.live) options.live->keyframes.fetch_add(1, std::memory_order_relaxed);
+    if (!loops) return;
+    if (threads) {
+      Stopwatch queue_watch;
+      threads->push(std::move(kf));
+      wait_queue_ms.push_back(queue_watch.elapsed_ms());
+    } else {
+      const LoopQuery query = detection.detect(kf);
+      const KeyframeStore::Hold hold(store);
+      closure.add(kf, query);
+    }
+  };
   Stopwatch waiting;
   while (auto item = prefetcher.next()) {
     wait_input_ms.push_back(waiting.elapsed_ms());
@@ -419,25 +485,14 @@ RunResult run_slam(const ScanSource& source, const SlamConfig& base_config,
       threads->wait_for_lag(index);
       wait_lag_ms.push_back(lag_watch.elapsed_ms());
     }
-    KeyframePtr kf;
+    std::vector<KeyframePtr> made;
     try {
-      kf = odometry.process(index, scan, result);
+      made = odometry.process(index, scan, result);
     } catch (const Error& e) {
       // Name the input and the scan: the odometry does not know where its scan came from.
       throw Error(source.describe() + ", scan " + std::to_string(index) + ": " + e.what());
     }
-    if (kf && options.live) options.live->keyframes.fetch_add(1, std::memory_order_relaxed);
-    if (kf && loops) {
-      if (threads) {
-        Stopwatch queue_watch;
-        threads->push(std::move(kf));
-        wait_queue_ms.push_back(queue_watch.elapsed_ms());
-      } else {
-        const LoopQuery query = detection.detect(kf);
-        const KeyframeStore::Hold hold(store);
-        closure.add(kf, query);
-      }
-    }
+    for (KeyframePtr& kf : made) hand_over(std::move(kf));
     const auto& f = result.timing_ms["features"];
     const auto& r = result.timing_ms["registration"];
     if (options.on_frame) options.on_frame(index, f.back(), r.back());
@@ -451,6 +506,7 @@ RunResult run_slam(const ScanSource& source, const SlamConfig& base_config,
       break;
     }
   }
+  for (KeyframePtr& kf : odometry.flush(result)) hand_over(std::move(kf));
   if (threads) threads->finish();
   if (loops) closure.finish();
   progress.finish();

@@ -1,14 +1,17 @@
 // The odometry's setting checks (PreprocessConfig::deskew_check, elevation_check): where the
-// other setting fits better the odometry switches to its shadow, and the trajectory it reports
-// continues without a jump across the switch. Short (40-50 frames) so that they also run under
+// other setting fits better the odometry switches to its shadow and revises the trial's frames
+// with the shadow's results, so that the trajectory is the one the winning setting makes from
+// the trial's first frame on, without a jump. Short (40-50 frames) so that they also run under
 // the sanitizers; the accuracy of the checks on whole drives is SimOdometry.DeskewCheck... and
 // SimOdometry.ElevationCheck... .
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <functional>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "scfloam/config.hpp"
 #include "scfloam/odometry/odometry.hpp"
@@ -19,11 +22,22 @@ namespace scfloam {
 namespace {
 
 // The worst error of a frame-to-frame step over a 40-frame drive (frames 2..), and the frame
-// at which `switched(odometry)` first held.
+// at which `switched(odometry)` first held; the poses as a caller that takes the revisions
+// (OdometryResult::revised) keeps them.
 struct SwitchRun {
   double worst_step_error_m = 0;
   std::size_t switched_at = 0;
+  std::size_t revised_frames = 0;  // on the switch frame
+  std::vector<Eigen::Isometry3d> poses;
+  std::vector<double> feature_sums;  // per frame: the sum of its edge and plane coordinates
 };
+
+double feature_sum(const OdometryResult& r) {
+  double sum = 0;
+  for (const FeatureCloud* cloud : {&r.edges, &r.planes})
+    for (const Eigen::Vector3f& p : *cloud) sum += p.cast<double>().sum();
+  return sum;
+}
 
 // `after_frame(k, odometry, result)`, when given, runs after each frame.
 template <typename Switched>
@@ -34,7 +48,7 @@ SwitchRun drive_through_switch(
   const sim::Scenario sc = sim::build_scenario(cfg);
   const sim::BeamCalibration calib = sim::draw_beam_calibration(sensor, cfg.seed);
   const Eigen::Isometry3d T0_inv = sc.frame_pose(0).inverse();
-  Eigen::Isometry3d prev_gt, prev_est;
+  std::vector<Eigen::Isometry3d> gt;
   SwitchRun run;
   for (std::size_t k = 0; k < sc.frames; ++k) {
     sim::SweepPoses poses;
@@ -42,16 +56,23 @@ SwitchRun drive_through_switch(
     Scan scan = sim::render_scan(sc.world, sensor, calib, poses, cfg.seed, k);
     scan.timestamp_s = k * sc.frame_period_s;
     const OdometryResult result = odometry.process(scan);
-    const Eigen::Isometry3d est = result.T_world_lidar;
-    const Eigen::Isometry3d gt = T0_inv * poses.T_world_lidar;
-    if (run.switched_at == 0 && switched(odometry)) run.switched_at = k;
-    if (after_frame) after_frame(k, odometry, result);
-    if (k >= 2) {
-      const Eigen::Isometry3d e = (prev_gt.inverse() * gt).inverse() * (prev_est.inverse() * est);
-      run.worst_step_error_m = std::max(run.worst_step_error_m, e.translation().norm());
+    EXPECT_LE(result.revised.size(), k);
+    for (std::size_t i = 0; i < result.revised.size(); ++i) {
+      run.poses[k - result.revised.size() + i] = result.revised[i].T_world_lidar;
+      run.feature_sums[k - result.revised.size() + i] = feature_sum(result.revised[i]);
     }
-    prev_gt = gt;
-    prev_est = est;
+    run.poses.push_back(result.T_world_lidar);
+    run.feature_sums.push_back(feature_sum(result));
+    gt.push_back(T0_inv * poses.T_world_lidar);
+    if (run.switched_at == 0 && switched(odometry)) {
+      run.switched_at = k;
+      run.revised_frames = result.revised.size();
+    }
+    if (after_frame) after_frame(k, odometry, result);
+  }
+  for (std::size_t k = 2; k < sc.frames; ++k) {
+    const Eigen::Isometry3d e = (gt[k - 1].inverse() * gt[k]).inverse() * (run.poses[k - 1].inverse() * run.poses[k]);
+    run.worst_step_error_m = std::max(run.worst_step_error_m, e.translation().norm());
   }
   return run;
 }
@@ -68,15 +89,31 @@ sim::SimConfig short_drive(std::size_t frames, bool calibrated_beams) {
 }
 
 // The check switched to the shadow at the frame it reports, on a full window of frames that
-// clearly favoured the shadow, without a jump in the reported track.
-void expect_switch(const SettingCheck& check, const SwitchRun& run, const char* verdict) {
+// clearly favoured the shadow, and revised the trial's earlier frames (the trial began at
+// `trial_start`), without a jump in the reported track.
+void expect_switch(const SettingCheck& check, const SwitchRun& run, const char* verdict,
+                   std::size_t trial_start) {
   EXPECT_EQ(check.verdict, verdict);
   EXPECT_GT(run.switched_at, 5u);
   EXPECT_EQ(check.decided_at_frame, run.switched_at);
+  EXPECT_EQ(run.revised_frames, run.switched_at - trial_start);
   EXPECT_GT(check.residual_ratio, 1.05);
   EXPECT_GE(check.frames_compared, 15u);
   std::printf("  switched at frame %zu, worst step error %.4f m\n", run.switched_at, run.worst_step_error_m);
   EXPECT_LT(run.worst_step_error_m, 0.03) << "switched at frame " << run.switched_at;
+}
+
+// The same drive with the odometry configured as the check chose from the start, and no check:
+// where the trial began at frame 0, the revised track and features are exactly that one's.
+void expect_same_track_as(const OdometryConfig& chosen, const sim::SimConfig& cfg, const SwitchRun& checked) {
+  Odometry odometry(chosen);
+  const SwitchRun plain = drive_through_switch(cfg, odometry, [](const Odometry&) { return false; });
+  ASSERT_EQ(plain.poses.size(), checked.poses.size());
+  double worst_m = 0;
+  for (std::size_t k = 0; k < plain.poses.size(); ++k)
+    worst_m = std::max(worst_m, (plain.poses[k].matrix() - checked.poses[k].matrix()).cwiseAbs().maxCoeff());
+  EXPECT_LT(worst_m, 1e-9);
+  EXPECT_EQ(plain.feature_sums, checked.feature_sums);
 }
 
 TEST(DeskewCheck, CompensatedScansSwitchToTheRawOdometryWithoutAJump) {
@@ -87,9 +124,14 @@ TEST(DeskewCheck, CompensatedScansSwitchToTheRawOdometryWithoutAJump) {
   const SwitchRun run = drive_through_switch(short_drive(40, false), odometry, [](const Odometry& o) {
     return o.deskew_check().verdict == "compensated";
   });
-  // Measured: 1.5 cm at worst; without putting the raw odometry's world frame where the
-  // switch frame was reported, the switch step alone errs by 5.5 cm.
-  expect_switch(odometry.deskew_check(), run, "compensated");
+  expect_switch(odometry.deskew_check(), run, "compensated", 0);
+  // KITTI-like beams: the elevation check that follows keeps the correction (or is still
+  // measuring: either way this odometry's poses are the corrected ones).
+  EXPECT_NE(odometry.elevation_check().verdict, "no offset");
+  OdometryConfig raw = config;
+  raw.preprocess.deskew = false;
+  raw.preprocess.elevation_check = false;
+  expect_same_track_as(raw, short_drive(40, false), run);
 }
 
 // Calibrated HDL-64E beams, run with KITTI's correction: the odometry continues without it.
@@ -99,8 +141,11 @@ TEST(ElevationCheck, CalibratedBeamsSwitchToTheUncorrectedOdometryWithoutAJump) 
   const SwitchRun run = drive_through_switch(short_drive(40, true), odometry, [](const Odometry& o) {
     return o.elevation_check().verdict == "no offset";
   });
-  expect_switch(odometry.elevation_check(), run, "no offset");
+  expect_switch(odometry.elevation_check(), run, "no offset", 0);
   EXPECT_EQ(odometry.deskew_check().verdict, "off");
+  OdometryConfig uncorrected;
+  uncorrected.preprocess.elevation_correction_deg = 0;
+  expect_same_track_as(uncorrected, short_drive(40, true), run);
 }
 
 // Both checks configured: the deskew check runs first (whether the scans are distorted
@@ -121,6 +166,8 @@ TEST(ElevationCheck, WaitsForTheDeskewCheckThenRunsInTheOdometryItChose) {
   EXPECT_EQ(odometry.elevation_check().verdict, "no offset");
   EXPECT_EQ(odometry.elevation_check().decided_at_frame, run.switched_at);
   EXPECT_GT(run.switched_at, odometry.deskew_check().decided_at_frame + 15);
+  // The elevation trial began on the frame after the deskew verdict.
+  EXPECT_EQ(run.revised_frames, run.switched_at - odometry.deskew_check().decided_at_frame - 1);
   // Two switches, the second from an odometry already re-anchored once.
   std::printf("  switched at frame %zu, worst step error %.4f m\n", run.switched_at, run.worst_step_error_m);
   EXPECT_LT(run.worst_step_error_m, 0.03);
@@ -151,6 +198,8 @@ TEST(ElevationCheck, AMapRebuiltDuringTheTrialStartsTheShadowAgain) {
   std::printf("  switched at frame %zu, worst step error %.4f m\n", run.switched_at, run.worst_step_error_m);
   // The new shadow's first five frames and then a full window: not before frame 10 + 5 + 15.
   EXPECT_GE(run.switched_at, kResetAt + 5 + 15);
+  // Only the restarted shadow's frames (from the frame after the rebuild) are revised.
+  EXPECT_EQ(run.revised_frames, run.switched_at - kResetAt - 1);
   EXPECT_LT(run.worst_step_error_m, 0.03);
 }
 

@@ -35,6 +35,12 @@ struct OdometryResult {
   // prediction (RegistrationConfig::degeneracy_fallback); 6 when nothing matched.
   int weak_directions = 0;
   double elevation_correction_deg = 0;  // applied to this frame's features
+  // Set on the frame where a setting check switched to the other setting (this frame's result
+  // is then that setting's): its results for the trial's earlier frames, oldest first, in the
+  // same world frame. They replace the ones returned for the last `revised.size()` frames
+  // before this one, which the switched-off setting made; a caller that keeps a frame's
+  // result while `Odometry::trial_running()` can take them (the pipeline does).
+  std::vector<OdometryResult> revised;
 };
 
 // What one of the odometry's setting checks found (PreprocessConfig::deskew_check,
@@ -69,6 +75,9 @@ class Odometry {
   const RingLayoutInfo& ring_layout() const;
   const SettingCheck& deskew_check() const;
   const SettingCheck& elevation_check() const;
+  // A setting check is measuring: the frames returned since it began may be revised when it
+  // decides (OdometryResult::revised).
+  bool trial_running() const;
 
   // After a loop closure the pipeline moves past keyframes: rebuild the local map from
   // (corrected pose, features) pairs and continue from `T_world_lidar_now`.
@@ -81,8 +90,9 @@ class Odometry {
   // One frame in the odometry's own world frame (see Impl::T_out_own).
   OdometryResult process_frame(const Scan& scan);
   // A setting check's comparison of this frame's solve with the shadow odometry's (the other
-  // setting); may continue as the shadow.
-  void compare_with_shadow(const Scan& scan, const OdometryResult& own, const OdometryResult& other);
+  // setting); may continue as the shadow, and then makes `own` the shadow's result, with the
+  // trial's earlier frames revised.
+  void compare_with_shadow(const Scan& scan, OdometryResult& own, const OdometryResult& other);
 
   struct Impl;
   std::unique_ptr<Impl> impl_;
