@@ -93,6 +93,11 @@ int main(int argc, char** argv) {
     std::vector<FeatureCloud> edges, planes;
     for (std::size_t k = 0; k < frames; ++k) {
       OdometryResult r = odometry.process(seq.load(k));
+      // A setting check that switched replaces its trial's features.
+      for (std::size_t i = 0; i < r.revised.size(); ++i) {
+        edges[k - r.revised.size() + i] = std::move(r.revised[i].edges);
+        planes[k - r.revised.size() + i] = std::move(r.revised[i].planes);
+      }
       edges.push_back(std::move(r.edges));
       planes.push_back(std::move(r.planes));
     }

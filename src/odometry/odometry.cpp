@@ -200,7 +200,6 @@ OdometryResult Odometry::process(const Scan& scan) {
       s.trial_frames = 0;
     }
     other = s.shadow->process(scan);
-    s.shadow_results.push_back(other);
     ++s.trial_frames;
     ++s.check_frames;
   }
@@ -211,6 +210,7 @@ OdometryResult Odometry::process(const Scan& scan) {
     result.features_ms += other.features_ms;
     result.registration_ms += other.registration_ms;
     if (s.trial_frames == 1) s.trial_start = {result.T_world_lidar, other.T_world_lidar};
+    s.shadow_results.push_back(other);
     compare_with_shadow(scan, result, other);  // may replace impl_ (and `s` with it)
   }
   return result;
@@ -480,7 +480,8 @@ void Odometry::reset_map(
     const Eigen::Isometry3d& T_world_lidar_now) {
   Impl& s = *impl_;
   // A trial compares two maps grown alike; this one is now rebuilt from the keyframes (thinned,
-  // corrected), the shadow's is not. Its shadow starts again, with the next frame.
+  // corrected), the shadow's is not. Its shadow starts again, with the next frame. (The
+  // pipeline defers rebuilds while it holds a trial's frames: this is for other callers.)
   if (s.shadow) {
     s.shadow.reset();
     s.shadow_results.clear();

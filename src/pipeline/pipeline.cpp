@@ -257,9 +257,6 @@ class OdometryStage {
     result.elevation_check = odometry_.elevation_check();
     if (result.stamps_s.size() == 1 || result.ring_layout.source != odometry_.ring_layout().source)
       result.ring_layout = odometry_.ring_layout();
-    const auto rounds = static_cast<std::size_t>(std::max(0, odom.registration_rounds));
-    if (result.registration_rounds.size() <= rounds) result.registration_rounds.resize(rounds + 1, 0);
-    ++result.registration_rounds[rounds];
 
     if (!odom.revised.empty()) {
       if (odom.revised.size() > held_.size())
@@ -318,6 +315,9 @@ class OdometryStage {
     has_last_ = true;
     result.odometry_T_world_lidar.push_back(T_chain_);
     if (odom.degenerate) ++result.degenerate_frames;
+    const auto rounds = static_cast<std::size_t>(std::max(0, odom.registration_rounds));
+    if (result.registration_rounds.size() <= rounds) result.registration_rounds.resize(rounds + 1, 0);
+    ++result.registration_rounds[rounds];
     if (result.odometry_T_world_lidar.size() == 1) result.elevation_correction_first_deg = odom.elevation_correction_deg;
     result.elevation_correction_last_deg = odom.elevation_correction_deg;
 

@@ -58,8 +58,8 @@ SwitchRun drive_through_switch(
     const OdometryResult result = odometry.process(scan);
     EXPECT_LE(result.revised.size(), k);
     for (std::size_t i = 0; i < result.revised.size(); ++i) {
-      run.poses[k - result.revised.size() + i] = result.revised[i].T_world_lidar;
-      run.feature_sums[k - result.revised.size() + i] = feature_sum(result.revised[i]);
+      run.poses.at(k - result.revised.size() + i) = result.revised[i].T_world_lidar;
+      run.feature_sums.at(k - result.revised.size() + i) = feature_sum(result.revised[i]);
     }
     run.poses.push_back(result.T_world_lidar);
     run.feature_sums.push_back(feature_sum(result));

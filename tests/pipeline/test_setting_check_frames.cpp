@@ -36,11 +36,11 @@ test::ScanListSource calibrated_drive(std::size_t frames) {
   return test::ScanListSource(std::move(scans));
 }
 
-RunResult run(const ScanSource& source, SlamMode mode, const SlamConfig& config) {
+RunResult run(const ScanSource& source, SlamMode mode, const SlamConfig& config, bool deterministic = true) {
   RunOptions options;
   options.mode = mode;
   options.progress = false;
-  options.deterministic = true;
+  options.deterministic = deterministic;
   return run_slam(source, config, options);
 }
 
@@ -71,6 +71,11 @@ TEST(SettingCheckFrames, ASwitchGivesTheRunConfiguredWithTheWinningSetting) {
     EXPECT_EQ(a.elevation_correction_first_deg, 0.0);
     expect_same_run(a, run(source, mode, uncorrected));
   }
+  // The loop stages on their threads get the held keyframes in one burst when the check
+  // decides; with no lag allowed the run is still the deterministic one.
+  SlamConfig threaded = checked;
+  threaded.pipeline.max_loop_lag_frames = 0;
+  expect_same_run(run(source, SlamMode::kOptimized, checked), run(source, SlamMode::kOptimized, threaded, false));
 }
 
 // The input ends before the check decides: the held frames keep the configured setting, as an

@@ -39,7 +39,8 @@ struct OdometryResult {
   // is then that setting's): its results for the trial's earlier frames, oldest first, in the
   // same world frame. They replace the ones returned for the last `revised.size()` frames
   // before this one, which the switched-off setting made; a caller that keeps a frame's
-  // result while `Odometry::trial_running()` can take them (the pipeline does).
+  // result while `Odometry::trial_running()` can take them (the pipeline does). This frame's
+  // pose continues the revised ones: against the unrevised track it may jump.
   std::vector<OdometryResult> revised;
 };
 
