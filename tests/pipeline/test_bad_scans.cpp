@@ -9,6 +9,7 @@
 #include <functional>
 #include <limits>
 
+#include "pipeline/run_quietly.hpp"
 #include "pipeline/scan_list_source.hpp"
 #include "scfloam/error.hpp"
 #include "scfloam/io/kitti.hpp"
@@ -51,11 +52,7 @@ RunResult run_spoiled(SlamMode mode, const std::function<void(Scan&, std::size_t
   std::vector<Scan> scans = good_scans();
   for (std::size_t i = 10; i < 13; ++i) spoil(scans[i], i);
   test::ScanListSource source(std::move(scans));
-  RunOptions options;
-  options.mode = mode;
-  options.progress = false;
-  options.deterministic = deterministic;
-  return run_slam(source, vlp16_config(), options);
+  return test::run_quietly(source, mode, vlp16_config(), deterministic);
 }
 
 void expect_finite_trajectory(const RunResult& result) {

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <cstdio>
 
+#include "pipeline/run_quietly.hpp"
 #include "scfloam/io/scan_source.hpp"
 #include "scfloam/pipeline/outputs.hpp"
 #include "scfloam/pipeline/pipeline.hpp"
@@ -44,20 +45,12 @@ Scene simulated(const std::string& name, std::size_t frames, bool traffic, std::
   return scene;
 }
 
-RunResult run(const ScanSource& source, SlamMode mode) {
-  RunOptions options;
-  options.mode = mode;
-  options.progress = false;
-  options.deterministic = true;
-  return run_slam(source, SlamConfig{}, options);
-}
-
 bool finite(const Eigen::Isometry3d& T) { return T.matrix().allFinite(); }
 
 // Both modes complete, every pose is finite, summary.json carries degenerate_frames.
 std::pair<RunResult, RunResult> run_both(const ScanSource& source) {
-  RunResult odometry = run(source, SlamMode::kOdometry);
-  RunResult optimized = run(source, SlamMode::kOptimized);
+  RunResult odometry = test::run_quietly(source, SlamMode::kOdometry);
+  RunResult optimized = test::run_quietly(source, SlamMode::kOptimized);
   for (const RunResult* r : {&odometry, &optimized}) {
     EXPECT_EQ(r->T_world_lidar.size(), source.size());
     for (std::size_t i = 0; i < r->T_world_lidar.size(); ++i) {
@@ -168,7 +161,7 @@ TEST(Degenerate, OpenFieldRecoversInTheNextVillage) {
     const Scene scene = simulated("open-field", 300, false, seed);
     const auto source = open_scan_source(scene.dir);
     const PoseList gt = source->ground_truth_lidar();
-    const RunResult odometry = run(*source, SlamMode::kOdometry);
+    const RunResult odometry = test::run_quietly(*source, SlamMode::kOdometry);
     const double after = worst_step_error_m(odometry.T_world_lidar, gt, scene.end + 20, gt.size());
     std::printf("open field, seed %d: worst step from 2 s into the second village %.3f m\n",
                 static_cast<int>(seed), after);
@@ -183,8 +176,8 @@ TEST(Degenerate, StationaryCarDoesNotDrift) {
   const auto source = open_scan_source(scene.dir);
   const PoseList gt = source->ground_truth_lidar();
   ASSERT_GT(scene.end, scene.first + 150);
-  const RunResult odometry = run(*source, SlamMode::kOdometry);
-  const RunResult optimized = run(*source, SlamMode::kOptimized);
+  const RunResult odometry = test::run_quietly(*source, SlamMode::kOdometry);
+  const RunResult optimized = test::run_quietly(*source, SlamMode::kOptimized);
   for (const RunResult* r : {&odometry, &optimized}) {
     const PoseList& est = r->T_world_lidar;
     ASSERT_EQ(est.size(), gt.size());

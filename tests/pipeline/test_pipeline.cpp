@@ -4,6 +4,7 @@
 // odometry's.
 #include <gtest/gtest.h>
 
+#include "pipeline/run_quietly.hpp"
 #include "scfloam/eval/report.hpp"
 #include "scfloam/io/kitti.hpp"
 #include "scfloam/io/scan_source.hpp"
@@ -31,15 +32,6 @@ fs::path loops_sequence() {
   return dir;
 }
 
-RunResult run(const ScanSource& source, SlamMode mode, const SlamConfig& config = {},
-              bool deterministic = true) {
-  RunOptions options;
-  options.mode = mode;
-  options.progress = false;
-  options.deterministic = deterministic;
-  return run_slam(source, config, options);
-}
-
 void expect_same_trajectory(const RunResult& a, const RunResult& b) {
   ASSERT_EQ(a.T_world_lidar.size(), b.T_world_lidar.size());
   for (std::size_t i = 0; i < a.T_world_lidar.size(); ++i)
@@ -62,11 +54,11 @@ EvalReport accuracy(const ScanSource& source, const PoseList& est) {
 TEST(Pipeline, OptimizedModeClosesTrueLoopsAndIsDeterministic) {
   const auto source = open_scan_source(loops_sequence());
   const PoseList gt = source->ground_truth_lidar();
-  const RunResult first = run(*source, SlamMode::kOptimized);
+  const RunResult first = test::run_quietly(*source, SlamMode::kOptimized);
   SlamConfig spilling_zero_lag;
   spilling_zero_lag.pipeline.resident_keyframes = 8;
   spilling_zero_lag.pipeline.max_loop_lag_frames = 0;
-  const RunResult second = run(*source, SlamMode::kOptimized, spilling_zero_lag, false);
+  const RunResult second = test::run_quietly(*source, SlamMode::kOptimized, spilling_zero_lag, false);
 
   ASSERT_EQ(first.T_world_lidar.size(), source->size());
   EXPECT_GT(second.timing_ms.count("wait_loop_lag"), 0u);  // it did run on the threads
@@ -98,7 +90,7 @@ TEST(Pipeline, OptimizedModeClosesTrueLoopsAndIsDeterministic) {
 
 TEST(Pipeline, OdometryModeMatchesTheOptimizedModesOdometry) {
   const auto source = open_scan_source(loops_sequence());
-  const RunResult odometry = run(*source, SlamMode::kOdometry);
+  const RunResult odometry = test::run_quietly(*source, SlamMode::kOdometry);
   EXPECT_TRUE(odometry.loop_rows.empty());
   EXPECT_EQ(odometry.T_world_lidar.size(), source->size());
   // Without loops the output is the odometry itself.

@@ -7,7 +7,8 @@
 
 #include <vector>
 
-#include "scan_list_source.hpp"
+#include "pipeline/run_quietly.hpp"
+#include "pipeline/scan_list_source.hpp"
 #include "scfloam/pipeline/pipeline.hpp"
 #include "scfloam/sim/scan.hpp"
 #include "scfloam/sim/simulate.hpp"
@@ -36,14 +37,6 @@ test::ScanListSource calibrated_drive(std::size_t frames) {
   return test::ScanListSource(std::move(scans));
 }
 
-RunResult run(const ScanSource& source, SlamMode mode, const SlamConfig& config, bool deterministic = true) {
-  RunOptions options;
-  options.mode = mode;
-  options.progress = false;
-  options.deterministic = deterministic;
-  return run_slam(source, config, options);
-}
-
 void expect_same_run(const RunResult& a, const RunResult& b) {
   ASSERT_EQ(a.T_world_lidar.size(), b.T_world_lidar.size());
   for (std::size_t i = 0; i < a.T_world_lidar.size(); ++i) {
@@ -63,19 +56,20 @@ TEST(SettingCheckFrames, ASwitchGivesTheRunConfiguredWithTheWinningSetting) {
   uncorrected.odometry.preprocess.elevation_correction_deg = 0;
   for (SlamMode mode : {SlamMode::kOdometry, SlamMode::kOptimized, SlamMode::kSimpleSc}) {
     SCOPED_TRACE(mode_name(mode));
-    const RunResult a = run(source, mode, checked);
+    const RunResult a = test::run_quietly(source, mode, checked);
     ASSERT_EQ(a.elevation_check.verdict, "no offset");
     EXPECT_GT(a.elevation_check.decided_at_frame, 5u);
     EXPECT_GE(a.keyframe_frames.size(), 3u);  // some were cut from the trial's frames
     EXPECT_LT(a.keyframe_frames.at(1), a.elevation_check.decided_at_frame);
     EXPECT_EQ(a.elevation_correction_first_deg, 0.0);
-    expect_same_run(a, run(source, mode, uncorrected));
+    expect_same_run(a, test::run_quietly(source, mode, uncorrected));
   }
   // The loop stages on their threads get the held keyframes in one burst when the check
   // decides; with no lag allowed the run is still the deterministic one.
   SlamConfig threaded = checked;
   threaded.pipeline.max_loop_lag_frames = 0;
-  expect_same_run(run(source, SlamMode::kOptimized, checked), run(source, SlamMode::kOptimized, threaded, false));
+  expect_same_run(test::run_quietly(source, SlamMode::kOptimized, checked),
+                  test::run_quietly(source, SlamMode::kOptimized, threaded, false));
 }
 
 // The input ends before the check decides: the held frames keep the configured setting, as an
@@ -85,8 +79,8 @@ TEST(SettingCheckFrames, AnInputThatEndsDuringTheTrialKeepsTheConfiguredSetting)
   const SlamConfig checked;
   SlamConfig unchecked;
   unchecked.odometry.preprocess.elevation_check = false;
-  const RunResult a = run(source, SlamMode::kOptimized, checked);
+  const RunResult a = test::run_quietly(source, SlamMode::kOptimized, checked);
   EXPECT_EQ(a.elevation_check.verdict, "trial");
   EXPECT_GT(a.elevation_correction_first_deg, 0.2);
-  expect_same_run(a, run(source, SlamMode::kOptimized, unchecked));
+  expect_same_run(a, test::run_quietly(source, SlamMode::kOptimized, unchecked));
 }
