@@ -42,6 +42,12 @@ endfunction()
 # the plain build only and the sanitizer stage runs the unit tests (`ctest -LE long`).
 set(SCFLOAM_LONG_TEST_SUITES Pipeline Degenerate LoopSequence LoopClosure SimOdometry
     CACHE STRING "GoogleTest suites labelled `long` in ctest")
+# Suites whose tests share an input the test file makes once per process (Pipeline: a 600-frame
+# simulated drive, ~50 CPU-s to simulate; LoopClosure: the keyframes of a drifting drive, four
+# tests): ctest runs each such suite as one test, in one process, rather than one process per
+# test, each making the input again.
+set(SCFLOAM_ONE_PROCESS_TEST_SUITES Pipeline LoopClosure
+    CACHE STRING "GoogleTest suites that ctest runs as one test (one process)")
 
 # scfloam_test_suite(<room> LIBS ...): tests/<room>/*.cpp as one GoogleTest program test_<room>.
 function(scfloam_test_suite room)
@@ -59,11 +65,32 @@ function(scfloam_test_suite room)
     SCFLOAM_SHARED_DIR="${SCFLOAM_SHARED_DIR}"
     SCFLOAM_BINARY_DIR="${CMAKE_BINARY_DIR}")
   # Suites listed in SCFLOAM_LONG_TEST_SUITES get the ctest label `long`; the rest are the unit
-  # tests. Two discoveries of the same program, split by gtest filter.
-  list(TRANSFORM SCFLOAM_LONG_TEST_SUITES APPEND ".*" OUTPUT_VARIABLE long_patterns)
+  # tests. Two discoveries of the same program, split by gtest filter; the one-process suites
+  # this program holds are a ctest test each, named after the suite.
+  set(long_suites ${SCFLOAM_LONG_TEST_SUITES})
+  list(REMOVE_ITEM long_suites ${SCFLOAM_ONE_PROCESS_TEST_SUITES})
+  list(TRANSFORM long_suites APPEND ".*" OUTPUT_VARIABLE long_patterns)
+  list(TRANSFORM SCFLOAM_ONE_PROCESS_TEST_SUITES APPEND ".*" OUTPUT_VARIABLE one_process_patterns)
   string(JOIN ":" long_filter ${long_patterns})
-  gtest_discover_tests(test_${room} DISCOVERY_TIMEOUT 60 TEST_FILTER "-${long_filter}"
+  string(JOIN ":" not_unit_filter ${long_patterns} ${one_process_patterns})
+  gtest_discover_tests(test_${room} DISCOVERY_TIMEOUT 60 TEST_FILTER "-${not_unit_filter}"
                        PROPERTIES TIMEOUT 900)
   gtest_discover_tests(test_${room} DISCOVERY_TIMEOUT 60 TEST_FILTER "${long_filter}"
                        PROPERTIES TIMEOUT 900 LABELS long)
+  foreach(suite ${SCFLOAM_ONE_PROCESS_TEST_SUITES})
+    set(holds_suite FALSE)
+    foreach(source ${sources})
+      file(STRINGS ${source} lines REGEX "^TEST(_F)?\\(${suite},")
+      if(lines)
+        set(holds_suite TRUE)
+      endif()
+    endforeach()
+    if(holds_suite)
+      add_test(NAME ${suite} COMMAND test_${room} --gtest_filter=${suite}.*)
+      set_tests_properties(${suite} PROPERTIES TIMEOUT 900)
+      if(suite IN_LIST SCFLOAM_LONG_TEST_SUITES)
+        set_tests_properties(${suite} PROPERTIES LABELS long)
+      endif()
+    endif()
+  endforeach()
 endfunction()

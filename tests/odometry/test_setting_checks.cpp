@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <functional>
+#include <map>
 #include <string>
 #include <utility>
 #include <vector>
@@ -39,22 +40,49 @@ double feature_sum(const OdometryResult& r) {
   return sum;
 }
 
-// `after_frame(k, odometry, result)`, when given, runs after each frame.
-template <typename Switched>
-SwitchRun drive_through_switch(
-    const sim::SimConfig& cfg, Odometry& odometry, Switched switched,
-    const std::function<void(std::size_t, Odometry&, const OdometryResult&)>& after_frame = {}) {
+// A short drive's scans and ground truth (relative to its first frame).
+struct Drive {
+  std::vector<Scan> scans;
+  std::vector<Eigen::Isometry3d> gt;
+};
+
+// A short drive on the loops route (seed 23); `calibrated_beams`: an HDL-64E without KITTI's
+// elevation error. Rendered once per process: a test runs the checked odometry and the one
+// configured as the check chose on the same scans.
+const Drive& short_drive(std::size_t frames, bool calibrated_beams) {
+  static std::map<std::pair<std::size_t, bool>, Drive> drives;
+  const auto key = std::make_pair(frames, calibrated_beams);
+  if (const auto it = drives.find(key); it != drives.end()) return it->second;
+  sim::SimConfig cfg;
+  cfg.route = "loops";
+  cfg.frames = frames;
+  cfg.seed = 23;
+  if (calibrated_beams) cfg.elevation_bias_deg = 0;
   const sim::SensorModel sensor = sim::sensor_for(cfg);
   const sim::Scenario sc = sim::build_scenario(cfg);
   const sim::BeamCalibration calib = sim::draw_beam_calibration(sensor, cfg.seed);
   const Eigen::Isometry3d T0_inv = sc.frame_pose(0).inverse();
-  std::vector<Eigen::Isometry3d> gt;
-  SwitchRun run;
+  Drive drive;
   for (std::size_t k = 0; k < sc.frames; ++k) {
     sim::SweepPoses poses;
     poses.T_world_lidar = sc.frame_pose(k);
-    Scan scan = sim::render_scan(sc.world, sensor, calib, poses, cfg.seed, k);
-    scan.timestamp_s = k * sc.frame_period_s;
+    drive.scans.push_back(sim::render_scan(sc.world, sensor, calib, poses, cfg.seed, k));
+    drive.scans.back().timestamp_s = k * sc.frame_period_s;
+    drive.gt.push_back(T0_inv * poses.T_world_lidar);
+  }
+  return drives.emplace(key, std::move(drive)).first->second;
+}
+
+// `after_frame(k, odometry, result)`, when given, runs after each frame.
+template <typename Switched>
+SwitchRun drive_through_switch(
+    const Drive& drive, Odometry& odometry, Switched switched,
+    const std::function<void(std::size_t, Odometry&, const OdometryResult&)>& after_frame = {}) {
+  const std::vector<Eigen::Isometry3d>& gt = drive.gt;
+  const std::size_t frames = drive.scans.size();
+  SwitchRun run;
+  for (std::size_t k = 0; k < frames; ++k) {
+    const Scan& scan = drive.scans[k];
     const OdometryResult result = odometry.process(scan);
     EXPECT_LE(result.revised.size(), k);
     for (std::size_t i = 0; i < result.revised.size(); ++i) {
@@ -63,29 +91,17 @@ SwitchRun drive_through_switch(
     }
     run.poses.push_back(result.T_world_lidar);
     run.feature_sums.push_back(feature_sum(result));
-    gt.push_back(T0_inv * poses.T_world_lidar);
     if (run.switched_at == 0 && switched(odometry)) {
       run.switched_at = k;
       run.revised_frames = result.revised.size();
     }
     if (after_frame) after_frame(k, odometry, result);
   }
-  for (std::size_t k = 2; k < sc.frames; ++k) {
+  for (std::size_t k = 2; k < frames; ++k) {
     const Eigen::Isometry3d e = (gt[k - 1].inverse() * gt[k]).inverse() * (run.poses[k - 1].inverse() * run.poses[k]);
     run.worst_step_error_m = std::max(run.worst_step_error_m, e.translation().norm());
   }
   return run;
-}
-
-// A short drive on the loops route (seed 23); `calibrated_beams`: an HDL-64E without KITTI's
-// elevation error.
-sim::SimConfig short_drive(std::size_t frames, bool calibrated_beams) {
-  sim::SimConfig cfg;
-  cfg.route = "loops";
-  cfg.frames = frames;
-  cfg.seed = 23;
-  if (calibrated_beams) cfg.elevation_bias_deg = 0;
-  return cfg;
 }
 
 // The check switched to the shadow at the frame it reports, on a full window of frames that
@@ -105,9 +121,9 @@ void expect_switch(const SettingCheck& check, const SwitchRun& run, const char* 
 
 // The same drive with the odometry configured as the check chose from the start, and no check:
 // where the trial began at frame 0, the revised track and features are exactly that one's.
-void expect_same_track_as(const OdometryConfig& chosen, const sim::SimConfig& cfg, const SwitchRun& checked) {
+void expect_same_track_as(const OdometryConfig& chosen, const Drive& drive, const SwitchRun& checked) {
   Odometry odometry(chosen);
-  const SwitchRun plain = drive_through_switch(cfg, odometry, [](const Odometry&) { return false; });
+  const SwitchRun plain = drive_through_switch(drive, odometry, [](const Odometry&) { return false; });
   ASSERT_EQ(plain.poses.size(), checked.poses.size());
   double worst_m = 0;
   for (std::size_t k = 0; k < plain.poses.size(); ++k)
@@ -152,12 +168,12 @@ TEST(ElevationCheck, CalibratedBeamsSwitchToTheUncorrectedOdometryWithoutAJump) 
 // changes every residual the elevation check compares), then the elevation check, in the
 // odometry the first one chose; the frames keep their index in the decisions.
 TEST(ElevationCheck, WaitsForTheDeskewCheckThenRunsInTheOdometryItChose) {
-  const sim::SimConfig cfg = short_drive(50, true);  // two trials: the second decides at ~frame 39
+  const Drive& drive = short_drive(50, true);  // two trials: the second decides at ~frame 39
   OdometryConfig config;
   config.preprocess.deskew = true;  // the scans carry times, but are compensated
   Odometry odometry(config);
   bool waited = false;
-  const SwitchRun run = drive_through_switch(cfg, odometry, [&](const Odometry& o) {
+  const SwitchRun run = drive_through_switch(drive, odometry, [&](const Odometry& o) {
     if (o.deskew_check().verdict == "trial") waited = o.elevation_check().verdict == "waiting";
     return o.elevation_check().verdict == "no offset";
   });
@@ -176,13 +192,13 @@ TEST(ElevationCheck, WaitsForTheDeskewCheckThenRunsInTheOdometryItChose) {
 // A loop closure rebuilds the odometry's map from keyframes during a trial: the two maps are no
 // longer grown alike, so the shadow starts again rather than compare against a thinned map.
 TEST(ElevationCheck, AMapRebuiltDuringTheTrialStartsTheShadowAgain) {
-  const sim::SimConfig cfg = short_drive(50, true);  // the restarted trial decides at ~frame 30
+  const Drive& drive = short_drive(50, true);  // the restarted trial decides at ~frame 30
   Odometry odometry(OdometryConfig{});
   std::vector<Eigen::Isometry3d> poses;
   std::vector<FeatureCloud> edges, planes;
   constexpr std::size_t kResetAt = 10;
   const SwitchRun run = drive_through_switch(
-      cfg, odometry, [](const Odometry& o) { return o.elevation_check().verdict == "no offset"; },
+      drive, odometry, [](const Odometry& o) { return o.elevation_check().verdict == "no offset"; },
       [&](std::size_t k, Odometry& o, const OdometryResult& r) {
         poses.push_back(r.T_world_lidar);
         edges.push_back(r.edges);

@@ -32,18 +32,25 @@ struct Drift {
   double max_tilt_drift_deg = 0;
 };
 
+// A drive's scans and ground truth, rendered once: tests that compare odometry settings run
+// each on the same scans (rendering costs more than the odometry).
+struct RenderedDrive {
+  std::string route;
+  std::vector<Scan> scans;
+  std::vector<Eigen::Isometry3d> gts;  // ground truth relative to the first frame
+  Eigen::Vector3d world_up;            // the world's up in the first frame's axes
+};
+
 // `firing_order`: points column by column, as a raw driver emits them (the simulator writes
-// them beam by beam). `rings`: where the odometry's rings came from, after the run.
-Drift run_sim(const sim::SimConfig& cfg, const OdometryConfig& odo_cfg, bool use_rings,
-              bool firing_order = false, RingLayoutInfo* rings = nullptr, SettingCheck* deskew = nullptr,
-              SettingCheck* elevation = nullptr) {
+// them beam by beam).
+RenderedDrive render_drive(const sim::SimConfig& cfg, bool firing_order = false) {
   const sim::SensorModel sensor = sim::sensor_for(cfg);
   const sim::Scenario sc = sim::build_scenario(cfg);
   const sim::BeamCalibration calib = sim::draw_beam_calibration(sensor, cfg.seed);
-  Odometry odometry(odo_cfg);
-  Drift d;
+  RenderedDrive drive;
+  drive.route = cfg.route;
   const Eigen::Isometry3d T0_inv = sc.frame_pose(0).inverse();
-  std::vector<Eigen::Isometry3d> gts, ests;
+  drive.world_up = T0_inv.linear() * Eigen::Vector3d::UnitZ();
   for (std::size_t k = 0; k < sc.frames; ++k) {
     sim::SweepPoses poses;
     const double t = k * sc.frame_period_s;
@@ -53,22 +60,44 @@ Drift run_sim(const sim::SimConfig& cfg, const OdometryConfig& odo_cfg, bool use
     poses.T_world_lidar_end = sc.trajectory.at(t + 0.5 * sensor.sweep_period_s);
     Scan scan = sim::render_scan(sc.world, sensor, calib, poses, cfg.seed, k);
     scan.timestamp_s = t;
-    scan.has_ring = scan.has_ring && use_rings;
     if (firing_order) {
       const double step = sensor.azimuth_step_deg() * M_PI / 180;
       std::stable_sort(scan.points.begin(), scan.points.end(), [&](const LidarPoint& a, const LidarPoint& b) {
         return std::lround((std::atan2(a.y, a.x) + M_PI) / step) < std::lround((std::atan2(b.y, b.x) + M_PI) / step);
       });
     }
-    const OdometryResult result = odometry.process(scan);
+    drive.scans.push_back(std::move(scan));
+    drive.gts.push_back(T0_inv * poses.T_world_lidar);
+  }
+  return drive;
+}
+
+// `use_rings`: whether the odometry sees the scans' ring field. `rings`, `deskew`,
+// `elevation`: what the odometry decided, after the run.
+Drift run_sim(const RenderedDrive& drive, const OdometryConfig& odo_cfg, bool use_rings,
+              RingLayoutInfo* rings = nullptr, SettingCheck* deskew = nullptr,
+              SettingCheck* elevation = nullptr) {
+  Odometry odometry(odo_cfg);
+  Drift d;
+  const std::vector<Eigen::Isometry3d>& gts = drive.gts;
+  std::vector<Eigen::Isometry3d> ests;
+  const std::size_t frames = drive.scans.size();
+  for (std::size_t k = 0; k < frames; ++k) {
+    OdometryResult result;
+    if (use_rings || !drive.scans[k].has_ring) {
+      result = odometry.process(drive.scans[k]);
+    } else {
+      Scan scan = drive.scans[k];
+      scan.has_ring = false;
+      result = odometry.process(scan);
+    }
     // A setting check that switched replaces its trial's frames, as the pipeline does.
     for (std::size_t i = 0; i < result.revised.size(); ++i)
       ests.at(k - result.revised.size() + i) = result.revised[i].T_world_lidar;
     ests.push_back(result.T_world_lidar);
-    gts.push_back(T0_inv * poses.T_world_lidar);
   }
   Eigen::Isometry3d prev_gt, prev_est, gt_anchor, est_anchor;
-  for (std::size_t k = 0; k < sc.frames; ++k) {
+  for (std::size_t k = 0; k < frames; ++k) {
     const Eigen::Isometry3d& est = ests[k];
     const Eigen::Isometry3d& gt = gts[k];
     if (k > 0) {
@@ -83,7 +112,7 @@ Drift run_sim(const sim::SimConfig& cfg, const OdometryConfig& odo_cfg, bool use
       est_anchor = est;
     } else if (k > kAttitudeFrom) {
       // World up in the anchor frame's sensor axes, then seen from frame k along each chain.
-      const Eigen::Vector3d up = gt_anchor.linear().transpose() * T0_inv.linear() * Eigen::Vector3d::UnitZ();
+      const Eigen::Vector3d up = gt_anchor.linear().transpose() * drive.world_up;
       const Eigen::Vector3d up_gt = (gt_anchor.inverse() * gt).linear().transpose() * up;
       const Eigen::Vector3d up_est = (est_anchor.inverse() * est).linear().transpose() * up;
       d.max_tilt_drift_deg = std::max(
@@ -97,7 +126,7 @@ Drift run_sim(const sim::SimConfig& cfg, const OdometryConfig& odo_cfg, bool use
   if (elevation) *elevation = odometry.elevation_check();
   std::printf("  %s, %zu frames: path %.1f m, end-point error %.3f m (%.3f %%), frame 1 error "
               "%.3f m, max later frame error %.3f m, max tilt drift %.3f deg\n",
-              cfg.route.c_str(), sc.frames, d.path_m, d.end_error_m, 100 * d.end_error_m / d.path_m,
+              drive.route.c_str(), frames, d.path_m, d.end_error_m, 100 * d.end_error_m / d.path_m,
               d.first_frame_error_m, d.max_frame_error_m, d.max_tilt_drift_deg);
   return d;
 }
@@ -123,7 +152,7 @@ TEST(SimOdometry, StraightAvenueDriftBelowOnePercent) {
   cfg.route = "straight";
   cfg.frames = 60;
   cfg.seed = 7;
-  const Drift d = run_sim(cfg, OdometryConfig{}, /*use_rings=*/false);
+  const Drift d = run_sim(render_drive(cfg), OdometryConfig{}, /*use_rings=*/false);
   EXPECT_GT(d.path_m, 40.0);
   EXPECT_LT(d.end_error_m / d.path_m, 0.01);
   EXPECT_LT(d.first_frame_error_m, 0.2);
@@ -138,7 +167,7 @@ TEST(SimOdometry, DistortedScansWithDeskewAndRingField) {
   cfg.motion_distortion = true;
   OdometryConfig odo;
   odo.preprocess.deskew = true;
-  const Drift d = run_sim(cfg, odo, /*use_rings=*/true);
+  const Drift d = run_sim(render_drive(cfg), odo, /*use_rings=*/true);
   EXPECT_LT(d.end_error_m / d.path_m, 0.01);
   // Frames 0-1 come before any velocity; frame 2 puts them into the map again, deskewed.
   // Measured: every later frame within 4 mm (end point 1.0 cm); when they stayed in the map
@@ -159,21 +188,23 @@ TEST(SimOdometry, DeskewCheckTellsDistortedFromCompensatedScans) {
   off.preprocess.deskew = false;
 
   cfg.motion_distortion = true;
+  const RenderedDrive distorted_drive = render_drive(cfg);
   SettingCheck check;
-  const Drift distorted = run_sim(cfg, preset, true, false, nullptr, &check);
+  const Drift distorted = run_sim(distorted_drive, preset, true, nullptr, &check);
   EXPECT_EQ(check.verdict, "distorted");
   EXPECT_LT(check.residual_ratio, 0.95);
-  const Drift distorted_forced = run_sim(cfg, forced, true);
+  const Drift distorted_forced = run_sim(distorted_drive, forced, true);
   // The deskewed odometry is the one reported throughout: the check changes nothing here.
   EXPECT_EQ(distorted.end_error_m, distorted_forced.end_error_m);
 
   cfg.motion_distortion = false;
-  const Drift compensated = run_sim(cfg, preset, true, false, nullptr, &check);
+  const RenderedDrive compensated_drive = render_drive(cfg);
+  const Drift compensated = run_sim(compensated_drive, preset, true, nullptr, &check);
   EXPECT_EQ(check.verdict, "compensated");
   EXPECT_GT(check.residual_ratio, 1.05);
   EXPECT_LT(check.decided_at_frame, 60u);
-  const Drift compensated_forced = run_sim(cfg, forced, true);
-  const Drift compensated_off = run_sim(cfg, off, true);
+  const Drift compensated_forced = run_sim(compensated_drive, forced, true);
+  const Drift compensated_off = run_sim(compensated_drive, off, true);
   // Deskewing compensated scans again puts each frame's motion off by up to 2.4 cm (1.0 cm
   // without deskew, measured); with the check the whole track is the raw odometry's (the
   // trial began at frame 0 and its frames were revised).
@@ -198,19 +229,23 @@ TEST(SimOdometry, ElevationCheckTellsKittiBeamsFromCalibratedOnes) {
   // KITTI-like beams (the simulator's HDL-64E: 0.205 deg low): the correction stays, and the
   // corrected odometry is the one reported throughout.
   SettingCheck check;
-  const Drift kitti = run_sim(cfg, checked, true, false, nullptr, nullptr, &check);
-  EXPECT_EQ(check.verdict, "offset");
-  EXPECT_LT(check.residual_ratio, 0.95);
-  EXPECT_LT(check.decided_at_frame, 60u);
-  EXPECT_EQ(kitti.end_error_m, run_sim(cfg, forced, true).end_error_m);
+  {
+    const RenderedDrive drive = render_drive(cfg);
+    const Drift kitti = run_sim(drive, checked, true, nullptr, nullptr, &check);
+    EXPECT_EQ(check.verdict, "offset");
+    EXPECT_LT(check.residual_ratio, 0.95);
+    EXPECT_LT(check.decided_at_frame, 60u);
+    EXPECT_EQ(kitti.end_error_m, run_sim(drive, forced, true).end_error_m);
+  }  // one drive's scans in memory at a time (150 HDL-64E scans: ~0.4 GB)
 
   cfg.elevation_bias_deg = 0;  // calibrated beams (each still off by its own 0.02 deg, 1 sigma)
-  const Drift calibrated = run_sim(cfg, checked, true, false, nullptr, nullptr, &check);
+  const RenderedDrive calibrated_drive = render_drive(cfg);
+  const Drift calibrated = run_sim(calibrated_drive, checked, true, nullptr, nullptr, &check);
   EXPECT_EQ(check.verdict, "no offset");
   EXPECT_GT(check.residual_ratio, 1.05);
   EXPECT_LT(check.decided_at_frame, 60u);
-  const Drift calibrated_forced = run_sim(cfg, forced, true);
-  const Drift calibrated_none = run_sim(cfg, none, true);
+  const Drift calibrated_forced = run_sim(calibrated_drive, forced, true);
+  const Drift calibrated_none = run_sim(calibrated_drive, none, true);
   // KITTI's correction on calibrated beams tilts the odometry steadily (measured, tilt drift
   // and end-point error: forced 0.40 deg, 0.38 m; none 0.035 deg, 0.022 m). The trial began at
   // frame 0 and the switch revised its frames: the checked track is the uncorrected one.
@@ -230,7 +265,7 @@ TEST(SimOdometry, Vlp16PresetHoldsTheAttitudeThroughTurns) {
   const sim::SimConfig cfg = loops_drive("vlp16", 300, 13);
   OdometryConfig odo = shipped_preset("vlp16");
   odo.preprocess.deskew = false;  // the scans are not distorted
-  const Drift d = run_sim(cfg, odo, /*use_rings=*/true);
+  const Drift d = run_sim(render_drive(cfg), odo, /*use_rings=*/true);
   EXPECT_GT(d.path_m, 200.0);
   EXPECT_LT(d.max_tilt_drift_deg, 0.5);
   EXPECT_LT(d.end_error_m / d.path_m, 0.002);
@@ -245,7 +280,7 @@ TEST(SimOdometry, UnknownBeamLayoutIsLearnedFromTheScans) {
   OdometryConfig odo = shipped_preset("hdl32");
   odo.preprocess.deskew = false;  // the scans are not distorted
   RingLayoutInfo rings;
-  const Drift d = run_sim(cfg, odo, /*use_rings=*/false, /*firing_order=*/true, &rings);
+  const Drift d = run_sim(render_drive(cfg, /*firing_order=*/true), odo, /*use_rings=*/false, &rings);
   EXPECT_EQ(rings.source, "learned");
   EXPECT_EQ(rings.beams, 32);
   EXPECT_NEAR(rings.highest_deg, 15.0, 0.02);

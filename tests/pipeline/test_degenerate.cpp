@@ -150,6 +150,11 @@ TEST(Degenerate, OpenFieldIsFlaggedAndTheMotionModelCarriesTheEstimate) {
   const double bound = field.model_error_m + 0.05 * field.length_m;
   EXPECT_LT(field.error_m, bound);
   EXPECT_LT(stretch_of(scene, optimized.T_world_lidar, gt).error_m, bound);
+  // After the field this world's second village is tracked frame by frame again (the next
+  // test checks two more worlds).
+  const double after = worst_step_error_m(est, gt, scene.end + 20, gt.size());
+  std::printf("open field, seed 3: worst step from 2 s into the second village %.3f m\n", after);
+  EXPECT_LT(after, 0.05);
 }
 
 // After the field, the second village is tracked frame by frame again. (Before session 7 the
@@ -157,7 +162,9 @@ TEST(Degenerate, OpenFieldIsFlaggedAndTheMotionModelCarriesTheEstimate) {
 // itself weak by the condition ratio, 0.07-0.10, and rode the field's velocity error at
 // 0.23-0.25 m per step to the end. docs/degenerate.md, "Session 7".)
 TEST(Degenerate, OpenFieldRecoversInTheNextVillage) {
-  for (const std::uint64_t seed : {3, 5, 9}) {  // three worlds: the barns and villages differ
+  // Two more worlds (the barns and villages differ); seed 3's is checked by the test above,
+  // which has its odometry at hand.
+  for (const std::uint64_t seed : {5, 9}) {
     const Scene scene = simulated("open-field", 300, false, seed);
     const auto source = open_scan_source(scene.dir);
     const PoseList gt = source->ground_truth_lidar();
