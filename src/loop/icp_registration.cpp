@@ -3,6 +3,8 @@
 #include <open3d/geometry/PointCloud.h>
 #include <open3d/pipelines/registration/Registration.h>
 
+#include <dlfcn.h>
+
 #include <cmath>
 
 #include "scfloam/loop/loop_registration.hpp"
@@ -17,6 +19,22 @@ void append(open3d::geometry::PointCloud& out, const FeatureCloud& points,
 }
 
 }  // namespace
+
+// The OpenMP runtime is Open3D's (libgomp, loaded with it); looked up at run time so that
+// neither compiler needs OpenMP's headers or flags for this. Without a runtime there is
+// nothing to do: ICP then runs on one thread anyway.
+IcpOnThisThreadRepeatable::IcpOnThisThreadRepeatable() {
+  void* set = ::dlsym(RTLD_DEFAULT, "omp_set_num_threads");
+  void* get = ::dlsym(RTLD_DEFAULT, "omp_get_max_threads");
+  if (!set || !get) return;
+  set_threads_ = reinterpret_cast<void (*)(int)>(set);
+  previous_threads_ = reinterpret_cast<int (*)()>(get)();
+  set_threads_(1);
+}
+
+IcpOnThisThreadRepeatable::~IcpOnThisThreadRepeatable() {
+  if (set_threads_ && previous_threads_ > 0) set_threads_(previous_threads_);
+}
 
 LoopMatch register_loop_icp(const KeyframeView& current, const std::vector<KeyframeView>& submap,
                             std::size_t loop_index, double sc_yaw_rad,

@@ -23,6 +23,7 @@
 #include "scfloam/error.hpp"
 #include "scfloam/loop/keyframe_selector.hpp"
 #include "scfloam/loop/loop_detector.hpp"
+#include "scfloam/loop/loop_registration.hpp"
 #include "scfloam/odometry/odometry.hpp"
 #include "scfloam/progress.hpp"
 #include "scfloam/registration/voxel_filter.hpp"
@@ -449,6 +450,9 @@ RunResult run_slam(const ScanSource& source, const SlamConfig& base_config,
     if (options.live) options.live->solves.fetch_add(1, std::memory_order_relaxed);
     if (options.on_solve) options.on_solve(sample);
   });
+  // Deterministic: the loop work below runs on this thread, ICP included.
+  std::optional<IcpOnThisThreadRepeatable> repeatable_icp;
+  if (loops && deterministic) repeatable_icp.emplace();
   std::optional<LoopThreads> threads;
   if (loops && !deterministic)
     threads.emplace(detection, closure, store, config.pipeline.queue_capacity,

@@ -98,4 +98,21 @@ LoopMatch register_loop_icp(const KeyframeView& current, const std::vector<Keyfr
                             std::size_t loop_index, double sc_yaw_rad,
                             const LoopRegistrationConfig& config);
 
+// Open3D's ICP gathers its correspondences on OpenMP threads in the order they finish, so its
+// result varies in the last bits from run to run, and so do the loops and poses that follow.
+// While an object of this class lives, ICP called from the thread that made it runs on one
+// OpenMP thread and repeats itself exactly (the pipeline's deterministic mode). OpenMP keeps
+// the thread count per thread: other threads, and the threaded mode, are unaffected.
+class IcpOnThisThreadRepeatable {
+ public:
+  IcpOnThisThreadRepeatable();
+  ~IcpOnThisThreadRepeatable();
+  IcpOnThisThreadRepeatable(const IcpOnThisThreadRepeatable&) = delete;
+  IcpOnThisThreadRepeatable& operator=(const IcpOnThisThreadRepeatable&) = delete;
+
+ private:
+  void (*set_threads_)(int) = nullptr;
+  int previous_threads_ = 0;
+};
+
 }  // namespace scfloam
