@@ -1,6 +1,9 @@
 // Loop registration on simulated scans with known ground truth: the feature method and the ICP
 // baseline recover a known offset to a submap; a candidate from another place is rejected.
 #include <gtest/gtest.h>
+#include <dlfcn.h>
+
+#include <thread>
 
 #include "scfloam/config.hpp"
 #include "scfloam/loop/loop_registration.hpp"
@@ -193,6 +196,37 @@ TEST_F(LoopRegistrationTest, IcpBaselineRecoversAKnownOffset) {
   const Eigen::Isometry3d error = truth.inverse() * match.T_loop_current;
   EXPECT_LT(error.translation().norm(), 0.15);
   EXPECT_LT(rotation_angle_rad(error.linear()) * 180 / M_PI, 0.5);
+}
+
+// Deterministic runs: with the guard, ICP from this thread runs on one OpenMP thread and repeats
+// itself bit for bit; other threads keep their count, and this one gets its own back after.
+TEST_F(LoopRegistrationTest, IcpRepeatsItselfExactlyUnderTheDeterministicGuard) {
+  using MaxThreads = int (*)();
+  const auto max_threads = reinterpret_cast<MaxThreads>(::dlsym(RTLD_DEFAULT, "omp_get_max_threads"));
+  ASSERT_NE(max_threads, nullptr) << "Open3D's OpenMP runtime (libgomp) is not loaded";
+  const int before = max_threads();
+  const std::size_t loop_frame = 150;
+  const auto submap = make_submap(loop_frame, 4);
+  const Eigen::Isometry3d T_world_current = scenario_->frame_pose(loop_frame) * offset(0.4, 1.2, 5);
+  SimKeyframe current = make_keyframe(T_world_current, 9);
+  current.T_world_lidar = T_world_current * offset(0.6, -0.5, 3);
+  std::vector<LoopMatch> matches;
+  {
+    const IcpOnThisThreadRepeatable guard;
+    EXPECT_EQ(max_threads(), 1);
+    int other_thread = 0;
+    std::thread([&] { other_thread = max_threads(); }).join();
+    EXPECT_EQ(other_thread, before);
+    for (int i = 0; i < 3; ++i)
+      matches.push_back(register_loop_icp({current.T_world_lidar, &current.edges, &current.planes, &current.raw},
+                                          views(submap), 4, 0.0, LoopRegistrationConfig{}));
+  }
+  EXPECT_EQ(max_threads(), before);
+  ASSERT_TRUE(matches[0].accepted) << matches[0].reason;
+  for (int i = 1; i < 3; ++i) {
+    EXPECT_TRUE(matches[i].T_loop_current.matrix() == matches[0].T_loop_current.matrix()) << "run " << i;
+    EXPECT_EQ(matches[i].residual_m, matches[0].residual_m) << "run " << i;
+  }
 }
 
 TEST_F(LoopRegistrationTest, CandidateFromAnotherPlaceIsRejected) {
