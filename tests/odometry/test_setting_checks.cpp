@@ -14,6 +14,7 @@
 #include <utility>
 #include <vector>
 
+#include "odometry/rendered_drive.hpp"
 #include "scfloam/config.hpp"
 #include "scfloam/odometry/odometry.hpp"
 #include "scfloam/sim/scan.hpp"
@@ -40,17 +41,13 @@ double feature_sum(const OdometryResult& r) {
   return sum;
 }
 
-// A short drive's scans and ground truth (relative to its first frame).
-struct Drive {
-  std::vector<Scan> scans;
-  std::vector<Eigen::Isometry3d> gt;
-};
+using test::RenderedDrive;
 
 // A short drive on the loops route (seed 23); `calibrated_beams`: an HDL-64E without KITTI's
 // elevation error. Rendered once per process: a test runs the checked odometry and the one
 // configured as the check chose on the same scans.
-const Drive& short_drive(std::size_t frames, bool calibrated_beams) {
-  static std::map<std::pair<std::size_t, bool>, Drive> drives;
+const RenderedDrive& short_drive(std::size_t frames, bool calibrated_beams) {
+  static std::map<std::pair<std::size_t, bool>, RenderedDrive> drives;
   const auto key = std::make_pair(frames, calibrated_beams);
   if (const auto it = drives.find(key); it != drives.end()) return it->second;
   sim::SimConfig cfg;
@@ -58,27 +55,15 @@ const Drive& short_drive(std::size_t frames, bool calibrated_beams) {
   cfg.frames = frames;
   cfg.seed = 23;
   if (calibrated_beams) cfg.elevation_bias_deg = 0;
-  const sim::SensorModel sensor = sim::sensor_for(cfg);
-  const sim::Scenario sc = sim::build_scenario(cfg);
-  const sim::BeamCalibration calib = sim::draw_beam_calibration(sensor, cfg.seed);
-  const Eigen::Isometry3d T0_inv = sc.frame_pose(0).inverse();
-  Drive drive;
-  for (std::size_t k = 0; k < sc.frames; ++k) {
-    sim::SweepPoses poses;
-    poses.T_world_lidar = sc.frame_pose(k);
-    drive.scans.push_back(sim::render_scan(sc.world, sensor, calib, poses, cfg.seed, k));
-    drive.scans.back().timestamp_s = k * sc.frame_period_s;
-    drive.gt.push_back(T0_inv * poses.T_world_lidar);
-  }
-  return drives.emplace(key, std::move(drive)).first->second;
+  return drives.emplace(key, test::render_drive(cfg)).first->second;
 }
 
 // `after_frame(k, odometry, result)`, when given, runs after each frame.
 template <typename Switched>
 SwitchRun drive_through_switch(
-    const Drive& drive, Odometry& odometry, Switched switched,
+    const RenderedDrive& drive, Odometry& odometry, Switched switched,
     const std::function<void(std::size_t, Odometry&, const OdometryResult&)>& after_frame = {}) {
-  const std::vector<Eigen::Isometry3d>& gt = drive.gt;
+  const std::vector<Eigen::Isometry3d>& gt = drive.gts;
   const std::size_t frames = drive.scans.size();
   SwitchRun run;
   for (std::size_t k = 0; k < frames; ++k) {
@@ -121,7 +106,7 @@ void expect_switch(const SettingCheck& check, const SwitchRun& run, const char* 
 
 // The same drive with the odometry configured as the check chose from the start, and no check:
 // where the trial began at frame 0, the revised track and features are exactly that one's.
-void expect_same_track_as(const OdometryConfig& chosen, const Drive& drive, const SwitchRun& checked) {
+void expect_same_track_as(const OdometryConfig& chosen, const RenderedDrive& drive, const SwitchRun& checked) {
   Odometry odometry(chosen);
   const SwitchRun plain = drive_through_switch(drive, odometry, [](const Odometry&) { return false; });
   ASSERT_EQ(plain.poses.size(), checked.poses.size());
@@ -168,7 +153,7 @@ TEST(ElevationCheck, CalibratedBeamsSwitchToTheUncorrectedOdometryWithoutAJump) 
 // changes every residual the elevation check compares), then the elevation check, in the
 // odometry the first one chose; the frames keep their index in the decisions.
 TEST(ElevationCheck, WaitsForTheDeskewCheckThenRunsInTheOdometryItChose) {
-  const Drive& drive = short_drive(50, true);  // two trials: the second decides at ~frame 39
+  const RenderedDrive& drive = short_drive(50, true);  // two trials: the second decides at ~frame 39
   OdometryConfig config;
   config.preprocess.deskew = true;  // the scans carry times, but are compensated
   Odometry odometry(config);
@@ -192,7 +177,7 @@ TEST(ElevationCheck, WaitsForTheDeskewCheckThenRunsInTheOdometryItChose) {
 // A loop closure rebuilds the odometry's map from keyframes during a trial: the two maps are no
 // longer grown alike, so the shadow starts again rather than compare against a thinned map.
 TEST(ElevationCheck, AMapRebuiltDuringTheTrialStartsTheShadowAgain) {
-  const Drive& drive = short_drive(50, true);  // the restarted trial decides at ~frame 30
+  const RenderedDrive& drive = short_drive(50, true);  // the restarted trial decides at ~frame 30
   Odometry odometry(OdometryConfig{});
   std::vector<Eigen::Isometry3d> poses;
   std::vector<FeatureCloud> edges, planes;

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <vector>
 
+#include "odometry/rendered_drive.hpp"
 #include "scfloam/config.hpp"
 #include "scfloam/odometry/odometry.hpp"
 #include "scfloam/se3.hpp"
@@ -32,49 +33,9 @@ struct Drift {
   double max_tilt_drift_deg = 0;
 };
 
-// A drive's scans and ground truth, rendered once: tests that compare odometry settings run
-// each on the same scans (rendering costs more than the odometry).
-struct RenderedDrive {
-  std::string route;
-  std::vector<Scan> scans;
-  std::vector<Eigen::Isometry3d> gts;  // ground truth relative to the first frame
-  Eigen::Vector3d world_up;            // the world's up in the first frame's axes
-};
-
-// `firing_order`: points column by column, as a raw driver emits them (the simulator writes
-// them beam by beam).
-RenderedDrive render_drive(const sim::SimConfig& cfg, bool firing_order = false) {
-  const sim::SensorModel sensor = sim::sensor_for(cfg);
-  const sim::Scenario sc = sim::build_scenario(cfg);
-  const sim::BeamCalibration calib = sim::draw_beam_calibration(sensor, cfg.seed);
-  RenderedDrive drive;
-  drive.route = cfg.route;
-  const Eigen::Isometry3d T0_inv = sc.frame_pose(0).inverse();
-  drive.world_up = T0_inv.linear() * Eigen::Vector3d::UnitZ();
-  for (std::size_t k = 0; k < sc.frames; ++k) {
-    sim::SweepPoses poses;
-    const double t = k * sc.frame_period_s;
-    poses.T_world_lidar = sc.trajectory.at(t);
-    poses.motion_distortion = cfg.motion_distortion;
-    poses.T_world_lidar_start = sc.trajectory.at(t - 0.5 * sensor.sweep_period_s);
-    poses.T_world_lidar_end = sc.trajectory.at(t + 0.5 * sensor.sweep_period_s);
-    Scan scan = sim::render_scan(sc.world, sensor, calib, poses, cfg.seed, k);
-    scan.timestamp_s = t;
-    if (firing_order) {
-      const double step = sensor.azimuth_step_deg() * M_PI / 180;
-      std::stable_sort(scan.points.begin(), scan.points.end(), [&](const LidarPoint& a, const LidarPoint& b) {
-        return std::lround((std::atan2(a.y, a.x) + M_PI) / step) < std::lround((std::atan2(b.y, b.x) + M_PI) / step);
-      });
-    }
-    drive.scans.push_back(std::move(scan));
-    drive.gts.push_back(T0_inv * poses.T_world_lidar);
-  }
-  return drive;
-}
-
 // `use_rings`: whether the odometry sees the scans' ring field. `rings`, `deskew`,
 // `elevation`: what the odometry decided, after the run.
-Drift run_sim(const RenderedDrive& drive, const OdometryConfig& odo_cfg, bool use_rings,
+Drift run_sim(const test::RenderedDrive& drive, const OdometryConfig& odo_cfg, bool use_rings,
               RingLayoutInfo* rings = nullptr, SettingCheck* deskew = nullptr,
               SettingCheck* elevation = nullptr) {
   Odometry odometry(odo_cfg);
@@ -152,7 +113,7 @@ TEST(SimOdometry, StraightAvenueDriftBelowOnePercent) {
   cfg.route = "straight";
   cfg.frames = 60;
   cfg.seed = 7;
-  const Drift d = run_sim(render_drive(cfg), OdometryConfig{}, /*use_rings=*/false);
+  const Drift d = run_sim(test::render_drive(cfg), OdometryConfig{}, /*use_rings=*/false);
   EXPECT_GT(d.path_m, 40.0);
   EXPECT_LT(d.end_error_m / d.path_m, 0.01);
   EXPECT_LT(d.first_frame_error_m, 0.2);
@@ -167,7 +128,7 @@ TEST(SimOdometry, DistortedScansWithDeskewAndRingField) {
   cfg.motion_distortion = true;
   OdometryConfig odo;
   odo.preprocess.deskew = true;
-  const Drift d = run_sim(render_drive(cfg), odo, /*use_rings=*/true);
+  const Drift d = run_sim(test::render_drive(cfg), odo, /*use_rings=*/true);
   EXPECT_LT(d.end_error_m / d.path_m, 0.01);
   // Frames 0-1 come before any velocity; frame 2 puts them into the map again, deskewed.
   // Measured: every later frame within 4 mm (end point 1.0 cm); when they stayed in the map
@@ -188,7 +149,7 @@ TEST(SimOdometry, DeskewCheckTellsDistortedFromCompensatedScans) {
   off.preprocess.deskew = false;
 
   cfg.motion_distortion = true;
-  const RenderedDrive distorted_drive = render_drive(cfg);
+  const test::RenderedDrive distorted_drive = test::render_drive(cfg);
   SettingCheck check;
   const Drift distorted = run_sim(distorted_drive, preset, true, nullptr, &check);
   EXPECT_EQ(check.verdict, "distorted");
@@ -198,7 +159,7 @@ TEST(SimOdometry, DeskewCheckTellsDistortedFromCompensatedScans) {
   EXPECT_EQ(distorted.end_error_m, distorted_forced.end_error_m);
 
   cfg.motion_distortion = false;
-  const RenderedDrive compensated_drive = render_drive(cfg);
+  const test::RenderedDrive compensated_drive = test::render_drive(cfg);
   const Drift compensated = run_sim(compensated_drive, preset, true, nullptr, &check);
   EXPECT_EQ(check.verdict, "compensated");
   EXPECT_GT(check.residual_ratio, 1.05);
@@ -230,7 +191,7 @@ TEST(SimOdometry, ElevationCheckTellsKittiBeamsFromCalibratedOnes) {
   // corrected odometry is the one reported throughout.
   SettingCheck check;
   {
-    const RenderedDrive drive = render_drive(cfg);
+    const test::RenderedDrive drive = test::render_drive(cfg);
     const Drift kitti = run_sim(drive, checked, true, nullptr, nullptr, &check);
     EXPECT_EQ(check.verdict, "offset");
     EXPECT_LT(check.residual_ratio, 0.95);
@@ -239,7 +200,7 @@ TEST(SimOdometry, ElevationCheckTellsKittiBeamsFromCalibratedOnes) {
   }  // one drive's scans in memory at a time (150 HDL-64E scans: ~0.4 GB)
 
   cfg.elevation_bias_deg = 0;  // calibrated beams (each still off by its own 0.02 deg, 1 sigma)
-  const RenderedDrive calibrated_drive = render_drive(cfg);
+  const test::RenderedDrive calibrated_drive = test::render_drive(cfg);
   const Drift calibrated = run_sim(calibrated_drive, checked, true, nullptr, nullptr, &check);
   EXPECT_EQ(check.verdict, "no offset");
   EXPECT_GT(check.residual_ratio, 1.05);
@@ -265,7 +226,7 @@ TEST(SimOdometry, Vlp16PresetHoldsTheAttitudeThroughTurns) {
   const sim::SimConfig cfg = loops_drive("vlp16", 300, 13);
   OdometryConfig odo = shipped_preset("vlp16");
   odo.preprocess.deskew = false;  // the scans are not distorted
-  const Drift d = run_sim(render_drive(cfg), odo, /*use_rings=*/true);
+  const Drift d = run_sim(test::render_drive(cfg), odo, /*use_rings=*/true);
   EXPECT_GT(d.path_m, 200.0);
   EXPECT_LT(d.max_tilt_drift_deg, 0.5);
   EXPECT_LT(d.end_error_m / d.path_m, 0.002);
@@ -280,7 +241,7 @@ TEST(SimOdometry, UnknownBeamLayoutIsLearnedFromTheScans) {
   OdometryConfig odo = shipped_preset("hdl32");
   odo.preprocess.deskew = false;  // the scans are not distorted
   RingLayoutInfo rings;
-  const Drift d = run_sim(render_drive(cfg, /*firing_order=*/true), odo, /*use_rings=*/false, &rings);
+  const Drift d = run_sim(test::render_drive(cfg, /*firing_order=*/true), odo, /*use_rings=*/false, &rings);
   EXPECT_EQ(rings.source, "learned");
   EXPECT_EQ(rings.beams, 32);
   EXPECT_NEAR(rings.highest_deg, 15.0, 0.02);
