@@ -73,6 +73,10 @@ scfloam::cli::RegisterCommand reg("simulate", [](CLI::App& app) {
                   "velodyne/ as KITTI .bin (x y z reflectance) or binary .pcd with ring and per-point time "
                   "(for deskew of --motion-distortion scans)")
       ->check(CLI::IsMember({"bin", "pcd"}))->capture_default_str();
+  sub->add_option("--sweep-stamp", args->config.sweep_stamp,
+                  "Where in its sweep a scan is stamped: middle (KITTI), start (Ouster, Hesai) or end (Velodyne's "
+                  "ROS driver); point times count from it, poses.txt is the sensor there")
+      ->check(CLI::IsMember({"start", "middle", "end"}))->capture_default_str();
   sub->add_option("--range-noise", args->config.range_noise_m, "Range noise sigma in metres (default: the sensor's)")
       ->check(CLI::Range(0.0, 1.0));
   sub->add_option("--dropout", args->config.dropout_prob, "Random dropout probability (default: the sensor's)")

@@ -42,15 +42,21 @@ struct Odometry::Impl {
   // are kept so that frame 2 can put them into the map again, deskewed.
   std::vector<LidarPoint> early_points[2];
   Eigen::Isometry3d early_poses[2];
+  double early_reference_s[2] = {0, 0};
   bool early_has_ring = false;
   FeatureCloud raw_edges, raw_planes;  // raw_planes: filled on the first frame only
   FeatureCloud last_edges, last_planes;  // the previous frame's features, for the coarse pass
   std::size_t frames = 0;
   int rounds;
+  // Poses, motion and times are the solves' own: at each scan's reference time (its stamp, or
+  // the middle of a deskewed sweep that is not centred on its stamp: sweep_reference_s).
   Eigen::Isometry3d T_last = Eigen::Isometry3d::Identity();  // T_world_lidar of frame k-1
   Eigen::Isometry3d T_delta = Eigen::Isometry3d::Identity(); // T_{k-2}^-1 T_{k-1}
-  double last_stamp_s = 0;
+  double last_time_s = 0;
   double delta_dt_s = 0;
+  // The last frame's reported pose is T_last * last_to_stamp (identity when its reference
+  // time was its stamp).
+  Eigen::Isometry3d last_to_stamp = Eigen::Isometry3d::Identity();
   Eigen::Vector3d last_cleanup_position = Eigen::Vector3d::Zero();
   std::optional<ElevationCalibration> elevation;  // when the config estimates the offset
   std::optional<GroundElevationEstimate> ground_elevation;  // ... or takes it from the road's shape
@@ -72,7 +78,8 @@ struct Odometry::Impl {
   std::size_t first_frame = 0;   // the caller's index of this odometry's first frame
   std::vector<double> residual_ratios;
   // This odometry's world frame in the caller's: identity, unless a check switched to the
-  // shadow, whose world frame differs from the one already reported by the frames of the trial.
+  // shadow, whose world frame differs from the one already reported by the frames of the trial,
+  // or frame 0 was solved away from its stamp (the caller's world is the sensor at that stamp).
   Eigen::Isometry3d T_out_own = Eigen::Isometry3d::Identity();
 };
 
@@ -95,20 +102,42 @@ Eigen::Matrix3d left_jacobian(const Eigen::Vector3d& phi) {
          (angle - std::sin(angle)) / (angle * angle * angle) * K * K;
 }
 
-// The relative motion `T_delta` continued for `ratio` intervals at the same body-frame velocity.
-Eigen::Isometry3d scaled_motion(const Eigen::Isometry3d& T_delta, double ratio) {
-  // Regular frames keep exactly the last motion: recorded stamps jitter by a few ms (KITTI's
-  // times.txt does) while the spin period does not, so only a clear change (a dropped frame,
-  // a rate change) is worth following.
-  if (ratio > 1.0 / 1.5 && ratio < 1.5) return T_delta;
-  // A constant twist: exp(ratio * log(T_delta)) on SE(3), so a turning car follows the arc
-  // (scaling the chord instead puts the end of a 1 s turn a metre to the side).
+// A constant twist: exp(ratio * log(T_delta)) on SE(3), so a turning car follows the arc
+// (scaling the chord instead puts the end of a 1 s turn a metre to the side). Any real ratio,
+// negative ones going back in time.
+Eigen::Isometry3d motion_at_same_twist(const Eigen::Isometry3d& T_delta, double ratio) {
   const Eigen::Vector3d phi = so3_log(T_delta.linear());
   const Eigen::Vector3d v = left_jacobian(phi).inverse() * T_delta.translation();
   Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
   out.linear() = so3_exp(ratio * phi);
   out.translation() = left_jacobian(ratio * phi) * (ratio * v);
   return out;
+}
+
+// The relative motion `T_delta` continued for `ratio` intervals at the same body-frame velocity.
+Eigen::Isometry3d scaled_motion(const Eigen::Isometry3d& T_delta, double ratio) {
+  // Regular frames keep exactly the last motion: recorded stamps jitter by a few ms (KITTI's
+  // times.txt does) while the spin period does not, so only a clear change (a dropped frame,
+  // a rate change) is worth following.
+  if (ratio > 1.0 / 1.5 && ratio < 1.5) return T_delta;
+  return motion_at_same_twist(T_delta, ratio);
+}
+
+// The time, relative to the stamp, at which a deskewed scan is solved: the middle of its
+// sweep. Drivers stamp a sweep at its start (Ouster, Hesai: times 0 ... 0.1 s), its end
+// (Velodyne's ROS driver: -0.1 ... 0) or its middle (our simulator, KITTI). Deskewing to an end
+// puts the points half a sweep from their own times, and the velocity of the last two solves,
+// wrong by some small amount, then moves the whole scan by that error times 0.05 s; the solve
+// takes the shift into the pose, the next velocity into the next deskew, and the error grows
+// from frame to frame (measured: 64 % t_err on bench/foreign_world.py's sweeps, docs/odometry.md,
+// "Session 36"). Solved at the middle, an error of the velocity bends the scan symmetrically
+// and moves no pose. A sweep centred on its stamp to 1 % of its span keeps the stamp.
+double sweep_reference_s(const std::vector<LidarPoint>& points) {
+  if (points.empty()) return 0;
+  float t_min = points.front().time_s, t_max = t_min;
+  for (const LidarPoint& pt : points) t_min = std::min(t_min, pt.time_s), t_max = std::max(t_max, pt.time_s);
+  const double middle = 0.5 * (double(t_min) + double(t_max));
+  return std::abs(middle) <= 0.01 * (double(t_max) - double(t_min)) ? 0.0 : middle;
 }
 
 // The scan aligned to the previous frame alone with a wide search radius, from `T_pred`: the
@@ -300,7 +329,7 @@ void Odometry::compare_with_shadow(const Scan& scan, OdometryResult& own, const 
   now.deskew_open = deskew_open;
   now.elevation_open = elevation_open;
   now.first_frame = first_frame;
-  now.T_out_own = T_out_other;
+  now.T_out_own = T_out_other * now.T_out_own;  // the shadow's own frame may have moved (frame 0)
   // `shadow` now holds this odometry's former state, released here.
 }
 
@@ -312,17 +341,22 @@ OdometryResult Odometry::process_frame(const Scan& scan) {
 
   const std::vector<LidarPoint>* points = &scan.points;
   const bool deskew = c.preprocess.deskew && scan.has_time;
+  // The solve's time: the stamp, or the middle of a deskewed sweep (sweep_reference_s); the
+  // reported pose and features are moved back to the stamp at the end.
+  const double reference_s = deskew ? sweep_reference_s(scan.points) : 0.0;
+  const double time_s = scan.timestamp_s + reference_s;
   if (deskew && s.frames >= 2 && s.delta_dt_s > 0) {
     // Constant velocity from the last two poses, in the sensor's body frame.
     const Eigen::Vector3d omega = so3_log(s.T_delta.linear()) / s.delta_dt_s;
     const Eigen::Vector3d velocity = s.T_delta.translation() / s.delta_dt_s;
     if (s.frames == 2) redeskew_first_frames(omega, velocity);
     s.deskewed = scan.points;
-    deskew_constant_velocity(s.deskewed, omega, velocity);
+    deskew_constant_velocity(s.deskewed, omega, velocity, reference_s);
     points = &s.deskewed;
   }
   if (deskew && s.frames < 2) {
     s.early_points[s.frames] = scan.points;
+    s.early_reference_s[s.frames] = reference_s;
     s.early_has_ring = scan.has_ring && c.rings.use_ring_field;
   }
   result.elevation_correction_deg = s.elevation          ? s.elevation->correction_deg()
@@ -344,7 +378,7 @@ OdometryResult Odometry::process_frame(const Scan& scan) {
     // r = this frame's interval over the last one: after dropped frames (a 1 s gap) the car
     // has moved ten intervals' worth, and the map match only pulls in a good guess.
     const double ratio =
-        interval_ratio(s.frames >= 2 ? s.delta_dt_s : 0.0, scan.timestamp_s - s.last_stamp_s);
+        interval_ratio(s.frames >= 2 ? s.delta_dt_s : 0.0, time_s - s.last_time_s);
     const Eigen::Isometry3d T_pred = orthonormalized(s.T_last * scaled_motion(s.T_delta, ratio));
     // After a gap the prediction is extrapolated over many intervals: give the frame the
     // first frame's rounds, and since a speed change over the gap can put the guess beyond
@@ -421,7 +455,7 @@ OdometryResult Odometry::process_frame(const Scan& scan) {
     if (s.ground_elevation && !gap && !result.degenerate)
       s.extractor.set_elevation_correction_deg(
           s.ground_elevation->update(*points, result.T_world_lidar, s.T_delta.translation()));
-    s.delta_dt_s = scan.timestamp_s - s.last_stamp_s;
+    s.delta_dt_s = time_s - s.last_time_s;
   }
   // The first frame seeds the map with its full-density features: frame 1 starts from a
   // zero-velocity guess, often 1 m off, and a map of one downsampled frame is too sparse to
@@ -440,7 +474,22 @@ OdometryResult Odometry::process_frame(const Scan& scan) {
   }
   if (s.frames < 2) s.early_poses[s.frames] = result.T_world_lidar;
   s.T_last = result.T_world_lidar;
-  s.last_stamp_s = scan.timestamp_s;
+  s.last_time_s = time_s;
+  // Solved away from the stamp: report the pose at the stamp, at the velocity just solved,
+  // and the features in the sensor frame there (the same points in the world). Frame 0 has
+  // no velocity yet: it was reported (the identity) where it was solved, and with frame 1's
+  // velocity the reported world becomes the sensor frame at frame 0's stamp.
+  s.last_to_stamp = Eigen::Isometry3d::Identity();
+  if (s.frames == 1 && s.early_reference_s[0] != 0 && s.delta_dt_s > 0)
+    s.T_out_own = s.T_out_own *
+                  motion_at_same_twist(s.T_delta, -s.early_reference_s[0] / s.delta_dt_s).inverse();
+  if (reference_s != 0 && s.frames >= 1 && s.delta_dt_s > 0) {
+    s.last_to_stamp = motion_at_same_twist(s.T_delta, -reference_s / s.delta_dt_s);
+    result.T_world_lidar = orthonormalized(result.T_world_lidar * s.last_to_stamp);
+    const Eigen::Isometry3f stamp_from_solve = s.last_to_stamp.inverse().cast<float>();
+    for (FeatureCloud* cloud : {&result.edges, &result.planes})
+      for (auto& pt : *cloud) pt = stamp_from_solve * pt;
+  }
   ++s.frames;
   result.registration_ms = watch.elapsed_ms();
   return result;
@@ -460,7 +509,7 @@ void Odometry::redeskew_first_frames(const Eigen::Vector3d& omega_rad_s,
   FeatureCloud edges, planes;
   for (int k = 0; k < 2; ++k) {
     std::vector<LidarPoint>& points = s.early_points[k];
-    deskew_constant_velocity(points, omega_rad_s, velocity_m_s);
+    deskew_constant_velocity(points, omega_rad_s, velocity_m_s, s.early_reference_s[k]);
     s.extractor.extract(points, s.early_has_ring, s.raw_edges, k == 0 ? &s.raw_planes : nullptr);
     if (k == 0) {
       // As on the first pass: frame 0 goes in at full density (see process()).
@@ -493,7 +542,8 @@ void Odometry::reset_map(
   for (const auto& [T, cloud] : edges_by_pose) s.map.insert(cloud ? *cloud : kEmpty, kEmpty, T_own_out * T);
   for (const auto& [T, cloud] : planes_by_pose) s.map.insert(kEmpty, cloud ? *cloud : kEmpty, T_own_out * T);
   // Keep the current velocity: T_delta is relative, so it survives the correction unchanged.
-  s.T_last = orthonormalized(T_own_out * T_world_lidar_now);
+  // The caller's pose is at the last stamp; ours at the last solve's time.
+  s.T_last = orthonormalized(T_own_out * T_world_lidar_now * s.last_to_stamp.inverse());
   s.map.remove_far(s.T_last.translation(), s.config.map.radius_m);
   s.last_cleanup_position = s.T_last.translation();
 }

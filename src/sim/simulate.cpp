@@ -50,6 +50,32 @@ Scenario build_scenario(const SimConfig& config) {
   return sc;
 }
 
+double sweep_middle_after_stamp_s(const std::string& sweep_stamp, const SensorModel& sensor) {
+  if (sweep_stamp == "middle") return 0;
+  if (sweep_stamp == "start") return 0.5 * sensor.sweep_period_s;
+  if (sweep_stamp == "end") return -0.5 * sensor.sweep_period_s;
+  throw Error("simulate: sweep stamp \"" + sweep_stamp + "\" is not start, middle or end");
+}
+
+Scan render_frame(const Scenario& sc, const SensorModel& sensor, const BeamCalibration& calib,
+                  const SimConfig& config, std::size_t k, const Traffic* traffic) {
+  const double stamp = sc.frame_time(k);
+  const double middle = stamp + sweep_middle_after_stamp_s(config.sweep_stamp, sensor);
+  SweepPoses poses;
+  poses.T_world_lidar = sc.trajectory.at(config.motion_distortion ? middle : stamp);
+  poses.motion_distortion = config.motion_distortion;
+  poses.T_world_lidar_start = sc.trajectory.at(middle - 0.5 * sensor.sweep_period_s);
+  poses.T_world_lidar_end = sc.trajectory.at(middle + 0.5 * sensor.sweep_period_s);
+  Scan scan = render_scan(sc.world, sensor, calib, poses, config.seed, k, traffic, middle);
+  // render_scan counts point times from the sweep's middle.
+  if (middle != stamp) {
+    const auto shift = static_cast<float>(middle - stamp);
+    for (LidarPoint& p : scan.points) p.time_s += shift;
+  }
+  scan.timestamp_s = stamp;
+  return scan;
+}
+
 PoseList relative_lidar_poses(const Scenario& sc) {
   PoseList out;
   const Pose T0_inv = sc.frame_pose(0).inverse();
@@ -63,6 +89,7 @@ void simulate_sequence(const SimConfig& config, const fs::path& out_dir, bool pr
   const bool pcd = config.scan_format == "pcd";
   Stopwatch clock;
   const SensorModel sensor = sensor_for(config);
+  sweep_middle_after_stamp_s(config.sweep_stamp, sensor);  // a bad name fails before any work
   const Scenario sc = build_scenario(config);
   const double world_ms = clock.elapsed_ms();
   const BeamCalibration calib = draw_beam_calibration(sensor, config.seed);
@@ -83,16 +110,10 @@ void simulate_sequence(const SimConfig& config, const fs::path& out_dir, bool pr
   ProgressBar bar("simulate", sc.frames, progress);
   std::size_t total_points = 0, movers_within_50m = 0;
   for (std::size_t k = 0; k < sc.frames; ++k) {
-    SweepPoses poses;
     const double t = sc.frame_time(k);
-    poses.T_world_lidar = sc.trajectory.at(t);
-    poses.motion_distortion = config.motion_distortion;
-    poses.T_world_lidar_start = sc.trajectory.at(t - 0.5 * sensor.sweep_period_s);
-    poses.T_world_lidar_end = sc.trajectory.at(t + 0.5 * sensor.sweep_period_s);
-    Scan scan = render_scan(sc.world, sensor, calib, poses, config.seed, k,
-                            config.traffic.enabled ? &traffic : nullptr, t);
+    Scan scan = render_frame(sc, sensor, calib, config, k, config.traffic.enabled ? &traffic : nullptr);
     apply_beam_losses(sc, k, sensor.beams(), &scan);
-    movers_within_50m += traffic.count_near(t, poses.T_world_lidar.translation().head<2>(), 50);
+    movers_within_50m += traffic.count_near(t, sc.trajectory.at(t).translation().head<2>(), 50);
     total_points += scan.points.size();
     char name[32];
     std::snprintf(name, sizeof name, "%06zu.%s", k, pcd ? "pcd" : "bin");
@@ -139,6 +160,7 @@ void simulate_sequence(const SimConfig& config, const fs::path& out_dir, bool pr
     out << "beam_range_bias_m: " << sensor.beam_range_bias_m << "\n";
     out << "motion_distortion: " << (config.motion_distortion ? "true" : "false") << "\n";
     out << "scan_format: " << config.scan_format << "\n";
+    out << "sweep_stamp: " << config.sweep_stamp << "\n";
     out << "world:\n  primitives: " << sc.world.primitives.size() << "\n  buildings: " << sc.stats.buildings
         << "\n  trees: " << sc.stats.trees << "\n  poles: " << sc.stats.poles << "\n  cars: " << sc.stats.cars
         << "\n  signs: " << sc.stats.signs << "\n";

@@ -432,5 +432,28 @@ TEST(Deskew, ConstantVelocityMovesPointsToTheReferenceTime) {
   EXPECT_NEAR(pts[0].y, 10 * std::sin(0.05), 3e-4);  // third-order term |wt|^3 / 6 * range
 }
 
+TEST(Deskew, AReferenceTimeIsWherePointsAreMovedTo) {
+  // A sweep stamped at its start (times 0 ... 0.1 s) solved at its middle: a point seen at
+  // 0.08 s is 0.03 s after the reference, 0.3 m further along at 10 m/s.
+  std::vector<LidarPoint> pts(1);
+  pts[0].x = 10, pts[0].y = 0, pts[0].z = 0, pts[0].time_s = 0.08f;
+  deskew_constant_velocity(pts, Eigen::Vector3d::Zero(), Eigen::Vector3d(10, 0, 0), 0.05);
+  EXPECT_NEAR(pts[0].x, 10.3f, 1e-5f);
+  EXPECT_EQ(pts[0].time_s, 0.08f);  // times stay relative to the stamp
+  // The same as times counted from the reference, turning as well.
+  std::vector<LidarPoint> a(2), b(2);
+  a[0].x = 4, a[0].y = -7, a[0].z = 1, a[0].time_s = 0.01f;
+  a[1].x = -20, a[1].y = 3, a[1].z = -1.5f, a[1].time_s = 0.097f;
+  for (int i = 0; i < 2; ++i) b[i] = a[i], b[i].time_s -= 0.05f;
+  const Eigen::Vector3d w(0.01, -0.02, 0.6), v(8, 0.3, -0.1);
+  deskew_constant_velocity(a, w, v, 0.05);
+  deskew_constant_velocity(b, w, v);
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_NEAR(a[i].x, b[i].x, 1e-5f) << i;
+    EXPECT_NEAR(a[i].y, b[i].y, 1e-5f) << i;
+    EXPECT_NEAR(a[i].z, b[i].z, 1e-5f) << i;
+  }
+}
+
 }  // namespace
 }  // namespace scfloam

@@ -14,30 +14,32 @@ namespace scfloam::test {
 
 struct RenderedDrive {
   std::string route;
-  std::vector<Scan> scans;
+  std::vector<Scan> scans;  // stamped at the middle of their sweeps, as the simulator does
   std::vector<Eigen::Isometry3d> gts;  // ground truth relative to the first frame
   Eigen::Vector3d world_up;            // the world's up in the first frame's axes
+  double sweep_period_s = 0.1;
+  // The sensor at the start and the end of each sweep, relative to the first sweep's.
+  std::vector<Eigen::Isometry3d> gts_at_sweep_start, gts_at_sweep_end;
 };
 
 // `firing_order`: points column by column, as a raw driver emits them (the simulator writes
-// them beam by beam).
-inline RenderedDrive render_drive(const sim::SimConfig& cfg, bool firing_order = false) {
+// them beam by beam). The scans are stamped at the middle of their sweeps (cfg.sweep_stamp is
+// not used: stamped_at below gives the same sweeps stamped otherwise).
+inline RenderedDrive render_drive(sim::SimConfig cfg, bool firing_order = false) {
+  cfg.sweep_stamp = "middle";
   const sim::SensorModel sensor = sim::sensor_for(cfg);
   const sim::Scenario sc = sim::build_scenario(cfg);
   const sim::BeamCalibration calib = sim::draw_beam_calibration(sensor, cfg.seed);
   RenderedDrive drive;
   drive.route = cfg.route;
   const Eigen::Isometry3d T0_inv = sc.frame_pose(0).inverse();
+  drive.sweep_period_s = sensor.sweep_period_s;
+  const Eigen::Isometry3d T0_start_inv = sc.trajectory.at(sc.frame_time(0) - 0.5 * sensor.sweep_period_s).inverse();
+  const Eigen::Isometry3d T0_end_inv = sc.trajectory.at(sc.frame_time(0) + 0.5 * sensor.sweep_period_s).inverse();
   drive.world_up = T0_inv.linear() * Eigen::Vector3d::UnitZ();
   for (std::size_t k = 0; k < sc.frames; ++k) {
-    sim::SweepPoses poses;
     const double t = sc.frame_time(k);
-    poses.T_world_lidar = sc.trajectory.at(t);
-    poses.motion_distortion = cfg.motion_distortion;
-    poses.T_world_lidar_start = sc.trajectory.at(t - 0.5 * sensor.sweep_period_s);
-    poses.T_world_lidar_end = sc.trajectory.at(t + 0.5 * sensor.sweep_period_s);
-    Scan scan = sim::render_scan(sc.world, sensor, calib, poses, cfg.seed, k);
-    scan.timestamp_s = t;
+    Scan scan = sim::render_frame(sc, sensor, calib, cfg, k);
     if (firing_order) {
       const double step = sensor.azimuth_step_deg() * M_PI / 180;
       std::stable_sort(scan.points.begin(), scan.points.end(), [&](const LidarPoint& a, const LidarPoint& b) {
@@ -45,9 +47,26 @@ inline RenderedDrive render_drive(const sim::SimConfig& cfg, bool firing_order =
       });
     }
     drive.scans.push_back(std::move(scan));
-    drive.gts.push_back(T0_inv * poses.T_world_lidar);
+    drive.gts.push_back(T0_inv * sc.trajectory.at(t));
+    drive.gts_at_sweep_start.push_back(T0_start_inv * sc.trajectory.at(t - 0.5 * sensor.sweep_period_s));
+    drive.gts_at_sweep_end.push_back(T0_end_inv * sc.trajectory.at(t + 0.5 * sensor.sweep_period_s));
   }
   return drive;
+}
+
+// The same sweeps as a driver that stamps each at its start (Ouster, Hesai: point times 0 ...
+// 0.1 s) or its end (Velodyne's ROS driver: -0.1 ... 0) gives them, with the ground truth at
+// those stamps.
+enum class SweepStamp { kStart, kEnd };
+inline RenderedDrive stamped_at(const RenderedDrive& drive, SweepStamp stamp) {
+  RenderedDrive out = drive;
+  const double shift = (stamp == SweepStamp::kStart ? -0.5 : 0.5) * drive.sweep_period_s;
+  for (Scan& scan : out.scans) {
+    scan.timestamp_s += shift;
+    for (LidarPoint& pt : scan.points) pt.time_s -= static_cast<float>(shift);
+  }
+  out.gts = stamp == SweepStamp::kStart ? drive.gts_at_sweep_start : drive.gts_at_sweep_end;
+  return out;
 }
 
 }  // namespace scfloam::test

@@ -256,5 +256,49 @@ TEST(SimulateMotionDistortion, ColumnsFollowTheMovingSensor) {
   EXPECT_NEAR(max_t, 0.05, 1e-3);
 }
 
+// `--sweep-stamp`: a scan stamped at its sweep's start, middle or end. Wherever the stamp is,
+// a point is the wall seen from the sensor at stamp + time_s, and a compensated scan is seen
+// from the sensor at the stamp (the sensor drives at 10 m/s along x towards a wall at x = 30).
+TEST(SimulateSweepStamp, PointTimesCountFromTheStampWhereverItIs) {
+  Scenario sc;
+  sc.world.terrain_m.reset(-200, -200, 4.0, 101, 101, 0.0f);
+  sc.world.road_edge_distance.reset(-200, -200, 4.0, 101, 101, -10.0f);
+  sc.world.primitives.push_back(make_box(30.5, 0, 0, 0.5, 80, -1, 20, SurfaceKind::building, 0.4f));
+  sc.world.build_index();
+  for (int i = 0; i <= 100; ++i) {
+    Pose T = Pose::Identity();
+    T.translation() = Eigen::Vector3d(0.1 * i, 0, 1.73);
+    sc.trajectory.T_world_lidar.push_back(T);
+  }
+  sc.frames = 3;
+  SensorModel s = sensor_preset("hdl64");
+  s.range_noise_m = 0;
+  s.dropout_prob = 0;
+  const BeamCalibration calib{std::vector<double>(64, 0), std::vector<double>(64, 0), std::vector<double>(64, 0)};
+  SimConfig cfg;
+  for (const auto& [stamp, first_time] : {std::pair<std::string, double>{"start", 0.0}, {"middle", -0.05}, {"end", -0.1}}) {
+    SCOPED_TRACE(stamp);
+    cfg.sweep_stamp = stamp;
+    for (const bool distorted : {true, false}) {
+      cfg.motion_distortion = distorted;
+      const Scan scan = render_frame(sc, s, calib, cfg, 1);  // stamped at 0.1 s, sensor at x = 1
+      EXPECT_EQ(scan.timestamp_s, 0.1);
+      int n = 0;
+      float min_t = 1, max_t = -1;
+      for (const auto& p : scan.points) {
+        min_t = std::min(min_t, p.time_s), max_t = std::max(max_t, p.time_s);
+        if (p.x < 20 || p.z < 0) continue;
+        EXPECT_NEAR(p.x, 29.0 - (distorted ? 10.0 * p.time_s : 0.0), 0.002);
+        ++n;
+      }
+      EXPECT_GT(n, 1000);
+      EXPECT_NEAR(min_t, first_time, 1e-3);
+      EXPECT_NEAR(max_t, first_time + 0.1, 1e-3);
+    }
+  }
+  cfg.sweep_stamp = "later";
+  EXPECT_THROW(render_frame(sc, s, calib, cfg, 1), Error);
+}
+
 }  // namespace
 }  // namespace scfloam::sim

@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <string>
 
+#include "scfloam/sim/scan.hpp"
 #include "scfloam/sim/scenario.hpp"
 #include "scfloam/sim/sensor.hpp"
 #include "scfloam/sim/traffic.hpp"
@@ -30,6 +31,11 @@ struct SimConfig {
   // velodyne/ as KITTI's "bin" (x y z reflectance), or "pcd" (binary PCD with ring and
   // per-point time, seconds from the frame's stamp): what deskew needs on distorted scans.
   std::string scan_format = "bin";
+  // Where in its sweep a scan is stamped: "middle" (KITTI; the sweep spans stamp -/+ 0.05 s),
+  // "start" (Ouster, Hesai: stamp ... stamp + 0.1 s) or "end" (Velodyne's ROS driver). Point
+  // times count from the stamp, poses.txt is the sensor at the stamp, and a compensated scan
+  // (no motion_distortion) is in the sensor frame at the stamp.
+  std::string sweep_stamp = "middle";
   // Overrides of the preset's noise (negative = keep the preset's value).
   double range_noise_m = -1;
   double dropout_prob = -1;
@@ -45,6 +51,16 @@ struct SimConfig {
 SensorModel sensor_for(const SimConfig& config);
 // World + trajectory for the config (throws scfloam::Error for a bad route or poses file).
 Scenario build_scenario(const SimConfig& config);
+
+// The middle of a sweep minus its stamp: 0, +period/2 ("start") or -period/2 ("end"); throws
+// scfloam::Error for another name.
+double sweep_middle_after_stamp_s(const std::string& sweep_stamp, const SensorModel& sensor);
+
+// Frame k of the scenario as the sensor reports it: stamped at sc.frame_time(k), the sweep
+// where config.sweep_stamp puts it (cast along it with config.motion_distortion), point times
+// from the stamp. Beam losses of degenerate scenes are not applied (simulate_sequence does).
+Scan render_frame(const Scenario& sc, const SensorModel& sensor, const BeamCalibration& calib,
+                  const SimConfig& config, std::size_t k, const Traffic* traffic = nullptr);
 
 // Writes velodyne/NNNNNN.bin, calib.txt (KITTI's Tr), times.txt (10 Hz), poses.txt (camera-0
 // ground truth, first pose identity) and sim.yaml (the parameters used) into out_dir, which
