@@ -188,6 +188,7 @@ Odometry::~Odometry() = default;
 const RingLayoutInfo& Odometry::ring_layout() const { return impl_->extractor.ring_layout(); }
 
 const SettingCheck& Odometry::deskew_check() const { return impl_->deskew_check; }
+bool Odometry::deskews() const { return impl_->config.preprocess.deskew; }
 const SettingCheck& Odometry::elevation_check() const { return impl_->elevation_check; }
 bool Odometry::trial_running() const { return impl_->trial != Impl::Trial::kNone; }
 

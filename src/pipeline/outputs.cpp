@@ -5,17 +5,20 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <deque>
 #include <functional>
 
 #include "scfloam/atomic_file.hpp"
 #include "scfloam/backend/pose_graph.hpp"
 #include "scfloam/error.hpp"
 #include "scfloam/eval/report.hpp"
+#include "scfloam/features/deskew.hpp"
 #include "scfloam/io/kitti.hpp"
 #include "scfloam/io/point_cloud_file.hpp"
 #include "scfloam/io/trajectory.hpp"
 #include "scfloam/loop/loops_csv.hpp"
 #include "scfloam/registration/voxel_hash.hpp"
+#include "scfloam/se3.hpp"
 #include "scfloam/stats.hpp"
 
 namespace scfloam {
@@ -43,43 +46,84 @@ std::optional<Eigen::Isometry3d> output_Tr(const ScanSource& source, PoseFrame f
   return source.T_cam0_lidar();  // kCamera without Tr is refused by check_output_options
 }
 
-// Running sums of the points that fell into one voxel (doubles: map coordinates are large).
+// Running sums of the points that fell into one voxel, as offsets from the voxel's corner:
+// floats keep them exact to the input there, where sums of map coordinates (kilometres) would
+// need doubles, and the map of a long drive has millions of voxels (KITTI-00-like: 10.5 M).
 struct VoxelSum {
-  double x = 0, y = 0, z = 0, intensity = 0;
+  std::int32_t cx = 0, cy = 0, cz = 0;  // the voxel
+  float x = 0, y = 0, z = 0, intensity = 0;
   std::uint32_t count = 0;
 };
 
+// Centroid and mean intensity per voxel. Memory matters for the whole map: the sums live in a
+// deque (no copy of everything when it grows, as a vector's doubling makes), the index runs to
+// 75 % load, and take_points() releases both as it builds the result. Measured on the
+// KITTI-00-like replay (10.5 M voxels), the process's peak: 1450 MB before, see
+// docs/benchmarks.md "Session 36".
 class VoxelAverager {
  public:
-  explicit VoxelAverager(double leaf_m) : inv_leaf_(static_cast<float>(1.0 / leaf_m)) { index_.reset(1 << 16); }
+  explicit VoxelAverager(double leaf_m)
+      : leaf_(static_cast<float>(leaf_m)), inv_leaf_(static_cast<float>(1.0 / leaf_m)), index_(3) {
+    index_.reset(1 << 16);
+  }
   void add(const LidarPoint& p) {
     const Eigen::Vector3i c = voxel_coords(Eigen::Vector3f(p.x, p.y, p.z), inv_leaf_);
     const std::uint32_t i = index_.insert(voxel_key(c.x(), c.y(), c.z()), static_cast<std::uint32_t>(sums_.size()));
-    if (i == sums_.size()) sums_.emplace_back();
+    if (i == sums_.size()) sums_.push_back(VoxelSum{c.x(), c.y(), c.z()});
     VoxelSum& s = sums_[i];
-    s.x += p.x, s.y += p.y, s.z += p.z, s.intensity += p.intensity, ++s.count;
+    s.x += p.x - static_cast<float>(c.x()) * leaf_;
+    s.y += p.y - static_cast<float>(c.y()) * leaf_;
+    s.z += p.z - static_cast<float>(c.z()) * leaf_;
+    s.intensity += p.intensity;
+    ++s.count;
   }
-  std::vector<LidarPoint> points() const {
-    std::vector<LidarPoint> out(sums_.size());
-    for (std::size_t i = 0; i < sums_.size(); ++i) {
-      const VoxelSum& s = sums_[i];
-      out[i].x = static_cast<float>(s.x / s.count);
-      out[i].y = static_cast<float>(s.y / s.count);
-      out[i].z = static_cast<float>(s.z / s.count);
-      out[i].intensity = static_cast<float>(s.intensity / s.count);
+  // The voxels' centroids, in the order they were first filled; empties the averager.
+  std::vector<LidarPoint> take_points() {
+    index_ = FlatKeyIndex(3);
+    std::vector<LidarPoint> out;
+    out.reserve(sums_.size());
+    while (!sums_.empty()) {
+      const VoxelSum& s = sums_.front();
+      LidarPoint p;
+      p.x = static_cast<float>(s.cx) * leaf_ + s.x / static_cast<float>(s.count);
+      p.y = static_cast<float>(s.cy) * leaf_ + s.y / static_cast<float>(s.count);
+      p.z = static_cast<float>(s.cz) * leaf_ + s.z / static_cast<float>(s.count);
+      p.intensity = s.intensity / static_cast<float>(s.count);
+      out.push_back(p);
+      sums_.pop_front();  // frees the deque's blocks as they empty
     }
     return out;
   }
 
  private:
-  float inv_leaf_;
+  float leaf_, inv_leaf_;
   FlatKeyIndex index_;
-  std::vector<VoxelSum> sums_;
+  std::deque<VoxelSum> sums_;
 };
 
-// A keyframe's raw scan, range-cropped and voxel-averaged in its own lidar frame.
-std::vector<LidarPoint> keyframe_cloud(const ScanSource& source, std::size_t frame, const OutputOptions& options) {
-  const Scan scan = source.load(frame);
+// The sensor's velocity (body frame: angular, linear) at `frame` from the run's final
+// trajectory, over the intervals either side of it; nullopt with a single pose or no time step.
+std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> frame_velocity(const RunResult& result,
+                                                                          std::size_t frame) {
+  const PoseList& T = result.T_world_lidar;
+  if (T.size() < 2 || result.stamps_s.size() != T.size() || frame >= T.size()) return std::nullopt;
+  const std::size_t a = frame > 0 ? frame - 1 : frame, b = frame + 1 < T.size() ? frame + 1 : frame;
+  const double dt = result.stamps_s[b] - result.stamps_s[a];
+  if (!(dt > 0)) return std::nullopt;
+  const Eigen::Vector3d omega = so3_log(T[a].linear().transpose() * T[b].linear()) / dt;
+  const Eigen::Vector3d velocity = T[frame].linear().transpose() * (T[b].translation() - T[a].translation()) / dt;
+  return std::make_pair(omega, velocity);
+}
+
+// A keyframe's raw scan, deskewed when the odometry deskewed (poses are at the stamps, so to
+// the stamp), range-cropped and voxel-averaged in its own lidar frame. Raw sweeps left as
+// they are would smear the map by the distance driven in a sweep (~1 m at 10 m/s).
+std::vector<LidarPoint> keyframe_cloud(const ScanSource& source, const RunResult& result, std::size_t frame,
+                                       const OutputOptions& options) {
+  Scan scan = source.load(frame);
+  if (result.deskewed_scans && scan.has_time)
+    if (const auto velocity = frame_velocity(result, frame))
+      deskew_constant_velocity(scan.points, velocity->first, velocity->second);
   const double min_r2 = options.map_min_range_m * options.map_min_range_m;
   const double max_r2 = options.map_max_range_m * options.map_max_range_m;
   VoxelAverager voxels(options.map_voxel_m);
@@ -87,7 +131,7 @@ std::vector<LidarPoint> keyframe_cloud(const ScanSource& source, std::size_t fra
     const double r2 = double(p.x) * p.x + double(p.y) * p.y;
     if (r2 >= min_r2 && r2 <= max_r2) voxels.add(p);
   }
-  return voxels.points();
+  return voxels.take_points();
 }
 
 // Keyframe poses relative to the first frame (lidar convention), as the map and keyframes/ use.
@@ -113,7 +157,7 @@ void for_each_keyframe_cloud(const ScanSource& source, const RunResult& result, 
   for (std::size_t begin = 0; begin < n; begin += kBatch) {
     const std::size_t end = std::min(n, begin + kBatch);
     tbb::parallel_for(begin, end, [&](std::size_t k) {
-      batch[k - begin] = keyframe_cloud(source, result.keyframe_frames[k], options);
+      batch[k - begin] = keyframe_cloud(source, result, result.keyframe_frames[k], options);
     });
     for (std::size_t k = begin; k < end; ++k) use(k, batch[k - begin]);
   }
@@ -233,7 +277,7 @@ std::vector<LidarPoint> assemble_map(const ScanSource& source, const RunResult& 
       map.add(p);
     }
   });
-  return map.points();
+  return map.take_points();
 }
 
 namespace {
@@ -264,7 +308,7 @@ void write_keyframes(const fs::path& dir, const ScanSource& source, const RunRes
 }  // namespace
 
 void write_run_outputs(const fs::path& out_dir, const ScanSource& source, const RunResult& result,
-                       const nlohmann::json& summary, const OutputOptions& options) {
+                       nlohmann::json& summary, const OutputOptions& options) {
   check_output_options(source, options);
   const auto Tr = output_Tr(source, options.frame);
   auto convention = [&](const PoseList& lidar) {
@@ -287,6 +331,7 @@ void write_run_outputs(const fs::path& out_dir, const ScanSource& source, const 
     if (options.write_ply) write_ply(out_dir / "map.ply", map, PlyEncoding::kBinaryLittleEndian);
     if (options.save_keyframes) write_keyframes(out_dir / "keyframes", source, result, options);
   }
+  summary["peak_rss_mb"] = peak_rss_mb();
   write_file_atomic(out_dir / "summary.json", summary.dump(2) + "\n");
 }
 

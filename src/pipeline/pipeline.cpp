@@ -256,6 +256,7 @@ class OdometryStage {
     result.timing_ms["registration"].push_back(odom.registration_ms);
     result.deskew_check = odometry_.deskew_check();
     result.elevation_check = odometry_.elevation_check();
+    result.deskewed_scans = odometry_.deskews();
     if (result.stamps_s.size() == 1 || result.ring_layout.source != odometry_.ring_layout().source)
       result.ring_layout = odometry_.ring_layout();
 

@@ -12,6 +12,7 @@
 #include "scfloam/io/kitti.hpp"
 #include "scfloam/sim/scan.hpp"
 #include "scfloam/sim/simulate.hpp"
+#include "support/wall_ahead.hpp"
 #include "test_paths.hpp"
 
 namespace scfloam::sim {
@@ -226,15 +227,10 @@ TEST(SimulatePcdScans, RingAndTimeSurviveTheKittiReader) {
 TEST(SimulateMotionDistortion, ColumnsFollowTheMovingSensor) {
   // With distortion each column reports the static wall from where the sensor is at the
   // column's time: x = 30 - 10 m/s * time_s (uncompensated, like a raw sensor).
-  World w;
-  w.terrain_m.reset(-200, -200, 4.0, 101, 101, 0.0f);
-  w.road_edge_distance.reset(-200, -200, 4.0, 101, 101, -10.0f);
-  w.primitives.push_back(make_box(30.5, 0, 0, 0.5, 80, -1, 20, SurfaceKind::building, 0.4f));
-  w.build_index();
-  SensorModel s = sensor_preset("hdl64");
-  s.range_noise_m = 0;
-  s.dropout_prob = 0;
-  BeamCalibration calib{std::vector<double>(64, 0), std::vector<double>(64, 0), std::vector<double>(64, 0)};
+  const test::WallAhead wall = test::wall_ahead(1);
+  const World& w = wall.scenario.world;
+  const SensorModel& s = wall.sensor;
+  const BeamCalibration& calib = wall.calibration;
   SweepPoses poses;
   poses.T_world_lidar = Pose::Identity();
   poses.T_world_lidar.translation().z() = 1.73;
@@ -260,21 +256,10 @@ TEST(SimulateMotionDistortion, ColumnsFollowTheMovingSensor) {
 // a point is the wall seen from the sensor at stamp + time_s, and a compensated scan is seen
 // from the sensor at the stamp (the sensor drives at 10 m/s along x towards a wall at x = 30).
 TEST(SimulateSweepStamp, PointTimesCountFromTheStampWhereverItIs) {
-  Scenario sc;
-  sc.world.terrain_m.reset(-200, -200, 4.0, 101, 101, 0.0f);
-  sc.world.road_edge_distance.reset(-200, -200, 4.0, 101, 101, -10.0f);
-  sc.world.primitives.push_back(make_box(30.5, 0, 0, 0.5, 80, -1, 20, SurfaceKind::building, 0.4f));
-  sc.world.build_index();
-  for (int i = 0; i <= 100; ++i) {
-    Pose T = Pose::Identity();
-    T.translation() = Eigen::Vector3d(0.1 * i, 0, 1.73);
-    sc.trajectory.T_world_lidar.push_back(T);
-  }
-  sc.frames = 3;
-  SensorModel s = sensor_preset("hdl64");
-  s.range_noise_m = 0;
-  s.dropout_prob = 0;
-  const BeamCalibration calib{std::vector<double>(64, 0), std::vector<double>(64, 0), std::vector<double>(64, 0)};
+  const test::WallAhead wall = test::wall_ahead(3);
+  const Scenario& sc = wall.scenario;
+  const SensorModel& s = wall.sensor;
+  const BeamCalibration& calib = wall.calibration;
   SimConfig cfg;
   for (const auto& [stamp, first_time] : {std::pair<std::string, double>{"start", 0.0}, {"middle", -0.05}, {"end", -0.1}}) {
     SCOPED_TRACE(stamp);

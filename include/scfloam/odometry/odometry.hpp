@@ -74,6 +74,9 @@ class Odometry {
   OdometryResult process(const Scan& scan);
   // Where the feature extraction's rings come from (a table, learned beams, the ring field).
   const RingLayoutInfo& ring_layout() const;
+  // Whether scans with per-point times are deskewed now (configured, and not turned off by the
+  // deskew check).
+  bool deskews() const;
   const SettingCheck& deskew_check() const;
   const SettingCheck& elevation_check() const;
   // A setting check is measuring: the frames returned since it began may be revised when it

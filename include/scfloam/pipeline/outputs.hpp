@@ -38,12 +38,15 @@ nlohmann::json make_summary(const ScanSource& source, const RunResult& result);
 
 // poses_kitti.txt (every frame, in options.frame), poses_tum.txt (timestamped lidar poses),
 // odometry_kitti.txt, keyframes_kitti.txt, loops.csv, graph.g2o, map.pcd (+ map.ply),
-// keyframes/ on request, summary.json. Every file is written atomically.
+// keyframes/ on request, summary.json. Every file is written atomically. summary.json is
+// written last, with `peak_rss_mb` updated to the process's peak so far: assembling the map
+// re-reads the keyframes' scans and can take more memory than the run did.
 void write_run_outputs(const std::filesystem::path& out_dir, const ScanSource& source,
-                       const RunResult& result, const nlohmann::json& summary,
+                       const RunResult& result, nlohmann::json& summary,
                        const OutputOptions& options = {});
 
-// The map with intensity: every keyframe's raw scan re-read from the source, range-cropped,
+// The map with intensity: every keyframe's raw scan re-read from the source, deskewed as the
+// odometry deskewed (RunResult::deskewed_scans) at the final trajectory's velocity, range-cropped,
 // moved by its corrected pose and voxel-averaged (centroid and mean intensity per voxel).
 std::vector<LidarPoint> assemble_map(const ScanSource& source, const RunResult& result,
                                      const OutputOptions& options);

@@ -88,6 +88,9 @@ struct RunResult {
   double elevation_correction_first_deg = 0, elevation_correction_last_deg = 0;
   RingLayoutInfo ring_layout;  // where the rings came from (the last change of source)
   SettingCheck deskew_check;    // whether the scans proved motion-distorted (at the last frame)
+  // The odometry deskewed scans that carry point times (at the last frame): the map and the
+  // saved keyframe clouds deskew their raw scans too.
+  bool deskewed_scans = false;
   SettingCheck elevation_check;  // whether the scans proved to need the elevation correction
   // How many frames ran each number of correspondence rounds (index = rounds).
   std::vector<std::size_t> registration_rounds;
