@@ -520,6 +520,8 @@ def main():
     ap.add_argument("--radius", type=float, default=110.0, help="mean radius of the ring road, m")
     ap.add_argument("--frames", type=int, default=0, help="stop after this many scans (0: the whole drive)")
     ap.add_argument("--jobs", type=int, default=os.cpu_count())
+    ap.add_argument("--perfect-calibration", action="store_true",
+                    help="no per-beam elevation, azimuth or range errors (noise and dropouts stay)")
     a = ap.parse_args()
     if not (a.laps > 0 and a.radius >= 40 and a.frames >= 0 and a.jobs >= 1):
         ap.error("--laps must be > 0, --radius >= 40, --frames >= 0, --jobs >= 1")
@@ -533,6 +535,8 @@ def main():
     calib = {"el": rng.normal(0, math.radians(0.03), len(BEAMS_DEG)),
              "az": rng.normal(0, math.radians(0.03), len(BEAMS_DEG)),
              "bias": rng.normal(0, 0.01, len(BEAMS_DEG))}
+    if a.perfect_calibration:  # drawn all the same, so that the world and the drive do not change
+        calib = {k: np.zeros_like(v) for k, v in calib.items()}
     n = int(drive.duration / SCAN_PERIOD)
     if a.frames:
         n = min(n, a.frames)
