@@ -57,6 +57,8 @@ struct Odometry::Impl {
   // The last frame's reported pose is T_last * last_to_stamp (identity when its reference
   // time was its stamp).
   Eigen::Isometry3d last_to_stamp = Eigen::Isometry3d::Identity();
+  // Frame 0 solved away from its stamp, as reported: frame 1 revises its features.
+  std::optional<OdometryResult> frame0_result;
   Eigen::Vector3d last_cleanup_position = Eigen::Vector3d::Zero();
   std::optional<ElevationCalibration> elevation;  // when the config estimates the offset
   std::optional<GroundElevationEstimate> ground_elevation;  // ... or takes it from the road's shape
@@ -190,7 +192,7 @@ const RingLayoutInfo& Odometry::ring_layout() const { return impl_->extractor.ri
 const SettingCheck& Odometry::deskew_check() const { return impl_->deskew_check; }
 bool Odometry::deskews() const { return impl_->config.preprocess.deskew; }
 const SettingCheck& Odometry::elevation_check() const { return impl_->elevation_check; }
-bool Odometry::trial_running() const { return impl_->trial != Impl::Trial::kNone; }
+bool Odometry::may_revise() const { return impl_->trial != Impl::Trial::kNone || impl_->frame0_result; }
 
 OdometryResult Odometry::process(const Scan& scan) {
   Impl& s = *impl_;
@@ -230,6 +232,10 @@ OdometryResult Odometry::process(const Scan& scan) {
       s.trial_frames = 0;
     }
     other = s.shadow->process(scan);
+    // The shadow's own revisions (its frame 0) replace what it returned before.
+    for (std::size_t i = 0; i < other.revised.size(); ++i)
+      s.shadow_results.at(s.shadow_results.size() - other.revised.size() + i) = std::move(other.revised[i]);
+    other.revised.clear();
     ++s.trial_frames;
     ++s.check_frames;
   }
@@ -478,12 +484,24 @@ OdometryResult Odometry::process_frame(const Scan& scan) {
   s.last_time_s = time_s;
   // Solved away from the stamp: report the pose at the stamp, at the velocity just solved,
   // and the features in the sensor frame there (the same points in the world). Frame 0 has
-  // no velocity yet: it was reported (the identity) where it was solved, and with frame 1's
-  // velocity the reported world becomes the sensor frame at frame 0's stamp.
+  // no velocity yet: it was reported (the identity) where it was solved; with frame 1's
+  // velocity the reported world becomes the sensor frame at frame 0's stamp, and frame 0's
+  // result is revised with its features there (the pipeline holds frame 0 until then).
   s.last_to_stamp = Eigen::Isometry3d::Identity();
-  if (s.frames == 1 && s.early_reference_s[0] != 0 && s.delta_dt_s > 0)
-    s.T_out_own = s.T_out_own *
-                  motion_at_same_twist(s.T_delta, -s.early_reference_s[0] / s.delta_dt_s).inverse();
+  if (s.frames == 1 && s.frame0_result) {
+    s.frame0_result->T_world_lidar = s.T_out_own * s.frame0_result->T_world_lidar;  // as reported
+    if (s.delta_dt_s > 0) {
+      const Eigen::Isometry3d frame0_to_stamp =
+          motion_at_same_twist(s.T_delta, -s.early_reference_s[0] / s.delta_dt_s);
+      s.T_out_own = s.T_out_own * frame0_to_stamp.inverse();
+      // Frame 0's pose (the identity) now means its stamp; its features move there too.
+      const Eigen::Isometry3f stamp_from_solve = frame0_to_stamp.inverse().cast<float>();
+      for (FeatureCloud* cloud : {&s.frame0_result->edges, &s.frame0_result->planes})
+        for (auto& pt : *cloud) pt = stamp_from_solve * pt;
+    }
+    result.revised.push_back(std::move(*s.frame0_result));
+    s.frame0_result.reset();
+  }
   if (reference_s != 0 && s.frames >= 1 && s.delta_dt_s > 0) {
     s.last_to_stamp = motion_at_same_twist(s.T_delta, -reference_s / s.delta_dt_s);
     result.T_world_lidar = orthonormalized(result.T_world_lidar * s.last_to_stamp);
@@ -491,6 +509,7 @@ OdometryResult Odometry::process_frame(const Scan& scan) {
     for (FeatureCloud* cloud : {&result.edges, &result.planes})
       for (auto& pt : *cloud) pt = stamp_from_solve * pt;
   }
+  if (s.frames == 0 && reference_s != 0) s.frame0_result = result;
   ++s.frames;
   result.registration_ms = watch.elapsed_ms();
   return result;

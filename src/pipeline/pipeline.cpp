@@ -268,7 +268,7 @@ class OdometryStage {
       odom.revised.clear();
     }
     held_.push_back({frame, std::move(odom), std::nullopt});
-    if (odometry_.trial_running()) {
+    if (odometry_.may_revise()) {
       // A held frame's scan is gone by the time it may become a keyframe; the raw cloud does
       // not depend on the odometry's settings.
       if (raw_clouds()) held_.back().raw = downsampled_raw(scan, config_.pipeline.raw_leaf_m, raw_filter_);

@@ -20,6 +20,8 @@ struct RenderedDrive {
   double sweep_period_s = 0.1;
   // The sensor at the start and the end of each sweep, relative to the first sweep's.
   std::vector<Eigen::Isometry3d> gts_at_sweep_start, gts_at_sweep_end;
+  // The sensor at the middle of the first sweep, seen from the sensor at its start.
+  Eigen::Isometry3d first_middle_from_start = Eigen::Isometry3d::Identity();
 };
 
 // `firing_order`: points column by column, as a raw driver emits them (the simulator writes
@@ -36,6 +38,7 @@ inline RenderedDrive render_drive(sim::SimConfig cfg, bool firing_order = false)
   drive.sweep_period_s = sensor.sweep_period_s;
   const Eigen::Isometry3d T0_start_inv = sc.trajectory.at(sc.frame_time(0) - 0.5 * sensor.sweep_period_s).inverse();
   const Eigen::Isometry3d T0_end_inv = sc.trajectory.at(sc.frame_time(0) + 0.5 * sensor.sweep_period_s).inverse();
+  drive.first_middle_from_start = T0_start_inv * sc.frame_pose(0);
   drive.world_up = T0_inv.linear() * Eigen::Vector3d::UnitZ();
   for (std::size_t k = 0; k < sc.frames; ++k) {
     const double t = sc.frame_time(k);

@@ -35,12 +35,14 @@ struct OdometryResult {
   // prediction (RegistrationConfig::degeneracy_fallback); 6 when nothing matched.
   int weak_directions = 0;
   double elevation_correction_deg = 0;  // applied to this frame's features
-  // Set on the frame where a setting check switched to the other setting (this frame's result
-  // is then that setting's): its results for the trial's earlier frames, oldest first, in the
-  // same world frame. They replace the ones returned for the last `revised.size()` frames
-  // before this one, which the switched-off setting made; a caller that keeps a frame's
-  // result while `Odometry::trial_running()` can take them (the pipeline does). This frame's
-  // pose continues the revised ones: against the unrevised track it may jump.
+  // Results for earlier frames, oldest first, in the same world frame, replacing the ones
+  // returned for the last `revised.size()` frames before this one; a caller that keeps a
+  // frame's result while `Odometry::may_revise()` can take them (the pipeline does). Set
+  // - on the frame where a setting check switched to the other setting (this frame's result is
+  //   then that setting's): the trial's earlier frames as that setting made them; this frame's
+  //   pose continues the revised ones, against the unrevised track it may jump;
+  // - on frame 1 when frame 0 was solved away from its stamp (a deskewed sweep not centred on
+  //   it): frame 0 with its features moved to its stamp, which frame 1's velocity tells.
   std::vector<OdometryResult> revised;
 };
 
@@ -79,9 +81,9 @@ class Odometry {
   bool deskews() const;
   const SettingCheck& deskew_check() const;
   const SettingCheck& elevation_check() const;
-  // A setting check is measuring: the frames returned since it began may be revised when it
-  // decides (OdometryResult::revised).
-  bool trial_running() const;
+  // The frames returned since some point may still be revised (OdometryResult::revised): a
+  // setting check is measuring, or frame 0 waits for frame 1.
+  bool may_revise() const;
 
   // After a loop closure the pipeline moves past keyframes: rebuild the local map from
   // (corrected pose, features) pairs and continue from `T_world_lidar_now`.
