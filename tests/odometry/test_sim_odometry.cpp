@@ -136,10 +136,6 @@ TEST(SimOdometry, DistortedScansWithDeskewAndRingField) {
   EXPECT_LT(d.max_frame_error_m, 0.01);
 }
 
-// Scans with per-point times are deskewed only if they prove motion-distorted: some drivers and
-// datasets compensate the motion and keep the time field (the simulator's scans carry times
-// either way). The odometry runs without deskew alongside until the two solves' residuals
-// agree on which fits (PreprocessConfig::deskew_check).
 // A raw VLP-16 drive (motion-distorted sweeps with point times), rendered once per process.
 const test::RenderedDrive& distorted_vlp16_drive() {
   static const test::RenderedDrive drive = [] {
@@ -150,6 +146,10 @@ const test::RenderedDrive& distorted_vlp16_drive() {
   return drive;
 }
 
+// Scans with per-point times are deskewed only if they prove motion-distorted: some drivers and
+// datasets compensate the motion and keep the time field (the simulator's scans carry times
+// either way). The odometry runs without deskew alongside until the two solves' residuals
+// agree on which fits (PreprocessConfig::deskew_check).
 TEST(SimOdometry, DeskewCheckTellsDistortedFromCompensatedScans) {
   sim::SimConfig cfg = loops_drive("vlp16", 100, 19);
   const OdometryConfig preset = shipped_preset("vlp16");  // deskew on, check on
