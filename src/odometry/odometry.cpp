@@ -125,6 +125,14 @@ Eigen::Isometry3d scaled_motion(const Eigen::Isometry3d& T_delta, double ratio) 
   return motion_at_same_twist(T_delta, ratio);
 }
 
+// A frame's features re-expressed in the sensor frame `to_stamp` away (the same world points
+// under the pose moved by it).
+void move_features_to(OdometryResult& result, const Eigen::Isometry3d& to_stamp) {
+  const Eigen::Isometry3f stamp_from_solve = to_stamp.inverse().cast<float>();
+  for (FeatureCloud* cloud : {&result.edges, &result.planes})
+    for (auto& pt : *cloud) pt = stamp_from_solve * pt;
+}
+
 // The time, relative to the stamp, at which a deskewed scan is solved: the middle of its
 // sweep. Drivers stamp a sweep at its start (Ouster, Hesai: times 0 ... 0.1 s), its end
 // (Velodyne's ROS driver: -0.1 ... 0) or its middle (our simulator, KITTI). Deskewing to an end
@@ -495,9 +503,7 @@ OdometryResult Odometry::process_frame(const Scan& scan) {
           motion_at_same_twist(s.T_delta, -s.early_reference_s[0] / s.delta_dt_s);
       s.T_out_own = s.T_out_own * frame0_to_stamp.inverse();
       // Frame 0's pose (the identity) now means its stamp; its features move there too.
-      const Eigen::Isometry3f stamp_from_solve = frame0_to_stamp.inverse().cast<float>();
-      for (FeatureCloud* cloud : {&s.frame0_result->edges, &s.frame0_result->planes})
-        for (auto& pt : *cloud) pt = stamp_from_solve * pt;
+      move_features_to(*s.frame0_result, frame0_to_stamp);
     }
     result.revised.push_back(std::move(*s.frame0_result));
     s.frame0_result.reset();
@@ -505,9 +511,7 @@ OdometryResult Odometry::process_frame(const Scan& scan) {
   if (reference_s != 0 && s.frames >= 1 && s.delta_dt_s > 0) {
     s.last_to_stamp = motion_at_same_twist(s.T_delta, -reference_s / s.delta_dt_s);
     result.T_world_lidar = orthonormalized(result.T_world_lidar * s.last_to_stamp);
-    const Eigen::Isometry3f stamp_from_solve = s.last_to_stamp.inverse().cast<float>();
-    for (FeatureCloud* cloud : {&result.edges, &result.planes})
-      for (auto& pt : *cloud) pt = stamp_from_solve * pt;
+    move_features_to(result, s.last_to_stamp);
   }
   if (s.frames == 0 && reference_s != 0) s.frame0_result = result;
   ++s.frames;

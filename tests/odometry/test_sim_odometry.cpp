@@ -358,21 +358,17 @@ ElevationRun run_unknown_offset(const OdometryConfig& online, std::size_t frames
     return std::atan2(up_gt.cross(up_est).norm(), up_gt.dot(up_est)) * 180 / M_PI;
   };
   for (std::size_t k = 0; k < sc.frames; ++k) {
-    sim::SweepPoses poses;
-    const double t = k * sc.frame_period_s;
-    poses.T_world_lidar = poses.T_world_lidar_start = poses.T_world_lidar_end = sc.trajectory.at(t);
-    Scan scan = sim::render_scan(sc.world, sensor, calib, poses, cfg.seed, k);
-    scan.timestamp_s = t;
+    const Scan scan = sim::render_frame(sc, sensor, calib, cfg, k);
     const Eigen::Isometry3d est_fixed = odometry_fixed.process(scan).T_world_lidar;
     const OdometryResult r = odometry_online.process(scan);
     out.estimate_deg = r.elevation_correction_deg;
     // The attitude is compared after the estimate's convergence, from frame `from` on.
     if (k == from) {
-      gt0 = poses.T_world_lidar;
+      gt0 = sc.frame_pose(k);
       est0_fixed = est_fixed;
       est0_online = r.T_world_lidar;
     } else if (k > from) {
-      const Eigen::Isometry3d gt = gt0.inverse() * poses.T_world_lidar;
+      const Eigen::Isometry3d gt = gt0.inverse() * sc.frame_pose(k);
       out.tilt_fixed_deg = std::max(out.tilt_fixed_deg, tilt_deg(gt, est0_fixed.inverse() * est_fixed));
       out.tilt_online_deg = std::max(out.tilt_online_deg, tilt_deg(gt, est0_online.inverse() * r.T_world_lidar));
     }

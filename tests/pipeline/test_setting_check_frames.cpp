@@ -28,12 +28,7 @@ test::ScanListSource calibrated_drive(std::size_t frames) {
   const sim::Scenario sc = sim::build_scenario(cfg);
   const sim::BeamCalibration calib = sim::draw_beam_calibration(sensor, cfg.seed);
   std::vector<Scan> scans;
-  for (std::size_t k = 0; k < sc.frames; ++k) {
-    sim::SweepPoses poses;
-    poses.T_world_lidar = sc.frame_pose(k);
-    scans.push_back(sim::render_scan(sc.world, sensor, calib, poses, cfg.seed, k));
-    scans.back().timestamp_s = k * sc.frame_period_s;
-  }
+  for (std::size_t k = 0; k < sc.frames; ++k) scans.push_back(sim::render_frame(sc, sensor, calib, cfg, k));
   return test::ScanListSource(std::move(scans));
 }
 
