@@ -173,6 +173,18 @@ void simulate_sequence(const SimConfig& config, const fs::path& out_dir, bool pr
         << "\n  movers: " << traffic.movers().size()
         << "\n  mean_movers_within_50m: " << (sc.frames ? double(movers_within_50m) / sc.frames : 0.0) << "\n";
     out << "mean_points_per_scan: " << (sc.frames ? total_points / sc.frames : 0) << "\n";
+    // The errors drawn, beam by beam in the order of the sensor's elevations: the ground truth
+    // of a calibration (elevation offsets include elevation_bias_deg).
+    const auto list = [&](const char* name, const std::vector<double>& v, double scale) {
+      out << "  " << name << ": [";
+      for (std::size_t b = 0; b < v.size(); ++b) out << (b ? ", " : "") << v[b] * scale;
+      out << "]\n";
+    };
+    out << "beam_calibration:\n";
+    list("elevation_deg", sensor.elevations_deg, 1.0);
+    list("elevation_offset_deg", calib.elevation_offset_rad, 180.0 / M_PI);
+    list("azimuth_offset_deg", calib.azimuth_offset_rad, 180.0 / M_PI);
+    list("range_bias_m", calib.range_bias_m, 1.0);
   });
   if (progress)
     std::fprintf(stderr, "simulate: %zu frames, %.0f m, world %.1f s, total %.1f s, %zu points/scan -> %s\n",
