@@ -522,7 +522,13 @@ def main():
     ap.add_argument("--jobs", type=int, default=os.cpu_count())
     ap.add_argument("--perfect-calibration", action="store_true",
                     help="no per-beam elevation, azimuth or range errors (noise and dropouts stay)")
+    ap.add_argument("--calibration-errors", default="el,az,bias",
+                    help="which per-beam errors to keep, of el, az, bias (comma-separated; "
+                         "the others are zero; --perfect-calibration keeps none)")
     a = ap.parse_args()
+    keep = {k for k in a.calibration_errors.split(",") if k}
+    if not keep <= {"el", "az", "bias"}:
+        ap.error("--calibration-errors takes el, az and bias")
     if not (a.laps > 0 and a.radius >= 40 and a.frames >= 0 and a.jobs >= 1):
         ap.error("--laps must be > 0, --radius >= 40, --frames >= 0, --jobs >= 1")
     rng = np.random.default_rng(a.seed)
@@ -535,8 +541,8 @@ def main():
     calib = {"el": rng.normal(0, math.radians(0.03), len(BEAMS_DEG)),
              "az": rng.normal(0, math.radians(0.03), len(BEAMS_DEG)),
              "bias": rng.normal(0, 0.01, len(BEAMS_DEG))}
-    if a.perfect_calibration:  # drawn all the same, so that the world and the drive do not change
-        calib = {k: np.zeros_like(v) for k, v in calib.items()}
+    # Drawn all the same, so that the world and the drive do not change.
+    calib = {k: (v if k in keep and not a.perfect_calibration else np.zeros_like(v)) for k, v in calib.items()}
     n = int(drive.duration / SCAN_PERIOD)
     if a.frames:
         n = min(n, a.frames)
@@ -546,6 +552,11 @@ def main():
     write_text(os.path.join(a.out, "gt_tum.txt"), "".join(
         "%.9f %.6f %.6f %.6f %.9f %.9f %.9f %.9f\n" % (1.7e9 + t, *pi, *quat(Ri)) for t, Ri, pi in zip(stamps, R, p)))
     write_text(os.path.join(a.out, "times.txt"), "".join("%.9f\n" % (1.7e9 + t) for t in stamps))
+    # The calibration errors drawn, beam by beam from the top: the ground truth of a calibration.
+    fmt = lambda v: "[" + ", ".join("%.6g" % x for x in v) + "]"
+    write_text(os.path.join(a.out, "beam_calibration.yaml"),
+               "elevation_deg: %s\nelevation_offset_deg: %s\nazimuth_offset_deg: %s\nrange_bias_m: %s\n"
+               % (fmt(BEAMS_DEG), fmt(np.degrees(calib["el"])), fmt(np.degrees(calib["az"])), fmt(calib["bias"])))
     print("foreign_world: road %.0f m, %d houses/hedges/cars, %d trunks and poles, %d crowns, %d frames (%.0f s)"
           % (road_len, len(world.polys), len(world.cyls), len(world.spheres), n, n * SCAN_PERIOD), flush=True)
     CTX["args"] = (world, drive, calib, a.out, stamps, a.seed)
