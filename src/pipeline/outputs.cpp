@@ -63,7 +63,7 @@ struct VoxelSum {
 class VoxelAverager {
  public:
   explicit VoxelAverager(double leaf_m)
-      : leaf_(static_cast<float>(leaf_m)), inv_leaf_(static_cast<float>(1.0 / leaf_m)), index_(3) {
+      : leaf_(static_cast<float>(leaf_m)), inv_leaf_(static_cast<float>(1.0 / leaf_m)), index_(FlatKeyIndex::MaxLoad::kThreeQuarters) {
     index_.reset(1 << 16);
   }
   void add(const LidarPoint& p) {
@@ -79,7 +79,7 @@ class VoxelAverager {
   }
   // The voxels' centroids, in the order they were first filled; empties the averager.
   std::vector<LidarPoint> take_points() {
-    index_ = FlatKeyIndex(3);
+    index_ = FlatKeyIndex(FlatKeyIndex::MaxLoad::kThreeQuarters);
     std::vector<LidarPoint> out;
     out.reserve(sums_.size());
     while (!sums_.empty()) {

@@ -265,3 +265,37 @@ TEST(VoxelRuns, KeysAreThoseOfVoxelCoordsInEveryLane) {
 
 }  // namespace
 }  // namespace scfloam
+
+namespace scfloam {
+namespace {
+
+// The flat key table behind the voxel filter, the local map and map.pcd: every key stored is
+// found with its first value, at either load, through growth from empty and after a reset.
+TEST(FlatKeyIndex, StoresAndFindsEveryKeyAtEitherLoad) {
+  for (const auto load : {FlatKeyIndex::MaxLoad::kHalf, FlatKeyIndex::MaxLoad::kThreeQuarters}) {
+    FlatKeyIndex index(load);
+    EXPECT_EQ(index.find(voxel_key(0, 0, 0)), FlatKeyIndex::kNone);  // empty, never reset
+    for (int round = 0; round < 2; ++round) {
+      std::uint32_t next = 0;
+      for (int x = -30; x < 30; ++x)
+        for (int y = -30; y < 30; ++y)
+          for (int z = -5; z < 5; ++z, ++next) ASSERT_EQ(index.insert(voxel_key(x, y, z), next), next);
+      EXPECT_EQ(index.size(), 36000u);
+      // A key already there keeps its first value.
+      EXPECT_EQ(index.insert(voxel_key(-30, -30, -5), 999999u), 0u);
+      EXPECT_EQ(index.size(), 36000u);
+      std::uint32_t expected = 0;
+      for (int x = -30; x < 30; ++x)
+        for (int y = -30; y < 30; ++y)
+          for (int z = -5; z < 5; ++z) ASSERT_EQ(index.find(voxel_key(x, y, z)), expected++);
+      EXPECT_EQ(index.find(voxel_key(30, 0, 0)), FlatKeyIndex::kNone);
+      EXPECT_EQ(index.find(voxel_key(0, 0, -6)), FlatKeyIndex::kNone);
+      index.reset(100);  // empty again, for the second round
+      EXPECT_EQ(index.size(), 0u);
+      EXPECT_EQ(index.find(voxel_key(1, 2, 3)), FlatKeyIndex::kNone);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace scfloam

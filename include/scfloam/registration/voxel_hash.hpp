@@ -32,9 +32,13 @@ class FlatKeyIndex {
  public:
   static constexpr std::uint32_t kNone = 0xffffffffu;
 
-  // Grows past max_load_quarters / 4 of the slots: 2 (50 %, the default, short probes) or 3
-  // (75 %: a third fewer slots for tables of millions of keys built once, such as map.pcd's).
-  explicit FlatKeyIndex(unsigned max_load_quarters = 2) : max_load_quarters_(max_load_quarters) {}
+  // The load past which the table grows: half (the default, short probes) or three quarters
+  // (a third fewer slots for tables of millions of keys built once, such as map.pcd's). An
+  // enum, not a number: 0 would make reset() loop forever and a full table would make
+  // insert() probe forever.
+  enum class MaxLoad : unsigned { kHalf = 2, kThreeQuarters = 3 };
+  explicit FlatKeyIndex(MaxLoad max_load = MaxLoad::kHalf)
+      : max_load_quarters_(static_cast<unsigned>(max_load)) {}
 
   // Empties the table keeping capacity for at least `expected` keys at the maximum load.
   void reset(std::size_t expected) {
