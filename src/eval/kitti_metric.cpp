@@ -1,5 +1,6 @@
 #include "scfloam/eval/kitti_metric.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -31,6 +32,20 @@ long last_frame_from_segment_length(const std::vector<double>& dist_m, std::size
   return -1;
 }
 
+std::optional<Eigen::Vector3d> ground_truth_up(const PoseList& gt) {
+  if (gt.size() < 3) return std::nullopt;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const Pose& p : gt) mean += p.translation();
+  mean /= static_cast<double>(gt.size());
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const Pose& p : gt) cov += (p.translation() - mean) * (p.translation() - mean).transpose();
+  cov /= static_cast<double>(gt.size());
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);  // ascending
+  const Eigen::Vector3d spread = eig.eigenvalues().cwiseMax(0.0).cwiseSqrt();
+  if (!(spread(1) >= 5.0) || !(spread(0) <= 0.25 * spread(1))) return std::nullopt;
+  return eig.eigenvectors().col(0).normalized();
+}
+
 KittiMetric kitti_metric(const PoseList& gt, const PoseList& est) {
   if (gt.empty()) throw Error("KITTI metric: the ground truth has no poses");
   if (gt.size() != est.size())
@@ -42,7 +57,8 @@ KittiMetric kitti_metric(const PoseList& gt, const PoseList& est) {
   m.path_length_m = dist.back();
 
   std::array<double, kKittiSegmentLengthsM.size()> t_sum{}, r_sum{};
-  double t_total = 0, r_total = 0;
+  double t_total = 0, r_total = 0, vertical_total = 0, horizontal_total = 0;
+  const std::optional<Eigen::Vector3d> up = ground_truth_up(gt);
   for (std::size_t first = 0; first < gt.size(); first += kKittiStepFrames) {
     for (std::size_t li = 0; li < kKittiSegmentLengthsM.size(); ++li) {
       const double len = kKittiSegmentLengthsM[li];
@@ -57,6 +73,17 @@ KittiMetric kitti_metric(const PoseList& gt, const PoseList& est) {
       s.length_m = len;
       s.t_err_ratio = E.translation().norm() / len;
       s.r_err_rad_per_m = rotation_angle_rad(E.linear()) / len;
+      if (up) {
+        // t(E) is in the last frame's axes: turned into the world's to split it.
+        const Eigen::Vector3d error_world = gt[last].linear() * E.translation();
+        const double vertical = error_world.dot(*up);
+        s.vertical_ratio = std::abs(vertical) / len;
+        s.horizontal_ratio = (error_world - vertical * *up).norm() / len;
+        vertical_total += s.vertical_ratio;
+        horizontal_total += s.horizontal_ratio;
+      } else {
+        s.vertical_ratio = s.horizontal_ratio = kNaN;
+      }
       t_sum[li] += s.t_err_ratio;
       r_sum[li] += s.r_err_rad_per_m;
       t_total += s.t_err_ratio;
@@ -78,7 +105,10 @@ KittiMetric kitti_metric(const PoseList& gt, const PoseList& est) {
     const double n = static_cast<double>(m.segments);
     m.t_err_pct = 100.0 * t_total / n;
     m.r_err_deg_per_100m = 100.0 * kRadToDeg * r_total / n;
+    m.t_err_vertical_pct = up ? 100.0 * vertical_total / n : kNaN;
+    m.t_err_horizontal_pct = up ? 100.0 * horizontal_total / n : kNaN;
   } else {
+    m.t_err_vertical_pct = m.t_err_horizontal_pct = kNaN;
     m.t_err_pct = kNaN;
     m.r_err_deg_per_100m = kNaN;
     char buf[160];

@@ -59,6 +59,15 @@ std::string format_eval_table(const EvalReport& r) {
                 fixed(r.kitti.t_err_pct, 3).c_str(), fixed(r.kitti.r_err_deg_per_100m, 4).c_str());
   out += line;
   if (!r.kitti.note.empty()) out += "  note: " + r.kitti.note + "\n";
+  if (r.kitti.has_segments()) {
+    if (std::isfinite(r.kitti.t_err_vertical_pct)) {
+      std::snprintf(line, sizeof line, "  t_err across the ground truth's up: horizontal %s %%, vertical %s %%\n",
+                    fixed(r.kitti.t_err_horizontal_pct, 3).c_str(), fixed(r.kitti.t_err_vertical_pct, 3).c_str());
+      out += line;
+    } else {
+      out += "  t_err split: n/a (the ground truth spans no plane to take its up from)\n";
+    }
+  }
   out += "\nATE after SE(3) Umeyama alignment [m]\n";
   std::snprintf(line, sizeof line, "  rmse %s  mean %s  median %s  max %s\n",
                 fixed(r.ate.rmse_m, 3).c_str(), fixed(r.ate.mean_m, 3).c_str(),
@@ -82,6 +91,8 @@ std::string eval_json(const EvalReport& r) {
   j["frames"] = r.frames;
   j["t_err_pct"] = number_or_null(r.kitti.t_err_pct);
   j["r_err_deg_per_100m"] = number_or_null(r.kitti.r_err_deg_per_100m);
+  j["t_err_horizontal_pct"] = number_or_null(r.kitti.t_err_horizontal_pct);
+  j["t_err_vertical_pct"] = number_or_null(r.kitti.t_err_vertical_pct);
   j["kitti_segments"] = r.kitti.segments;
   j["path_length_m"] = r.kitti.path_length_m;
   nlohmann::ordered_json per_length = nlohmann::ordered_json::array();

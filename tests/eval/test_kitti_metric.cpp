@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <optional>
 
 #include "scfloam/error.hpp"
 #include "scfloam/eval/kitti_metric.hpp"
@@ -185,6 +186,68 @@ TEST(KittiMetric, ConvertingBothTrajectoriesToCameraKeepsRotationError) {
   // Mixing conventions is not a small change: lidar estimate against camera ground truth.
   const KittiMetric mixed = kitti_metric(lidar_to_camera_poses(gt, kitti_default_Tr()), est);
   EXPECT_GT(mixed.t_err_pct, 100.0);  // forward (z) compared with forward (x): ~141 %
+}
+
+}  // namespace
+}  // namespace scfloam
+
+namespace scfloam {
+namespace {
+
+// A climb of 1 cm per metre driven added to the estimate (its rotations exact): every segment's
+// error is vertical, 1 % of the distance driven in it; a 1 % scale across the plane of motion
+// is horizontal. The split does not depend on how the world is turned.
+TEST(KittiMetricSplit, VerticalAndHorizontalErrorsAlongTheGroundTruthsUp) {
+  Pose turn = Pose::Identity();
+  turn.linear() = so3_exp(Eigen::Vector3d(0.4, -0.9, 0.3));
+  for (const bool turned : {false, true}) {
+    PoseList gt = curved_path(1200, 0.003);  // KITTI camera axes: up is -y
+    const std::vector<double> dist = trajectory_distances_m(gt);
+    PoseList climb = gt, wide = gt;
+    for (std::size_t i = 0; i < gt.size(); ++i) {
+      climb[i].translation().y() -= 0.01 * dist[i];
+      wide[i].translation().x() *= 1.01;
+      wide[i].translation().z() *= 1.01;
+    }
+    if (turned)
+      for (PoseList* list : {&gt, &climb, &wide})
+        for (Pose& T : *list) T = turn * T;
+    const std::optional<Eigen::Vector3d> up = ground_truth_up(gt);
+    ASSERT_TRUE(up.has_value());
+    const Eigen::Matrix3d R = turned ? Eigen::Matrix3d(turn.linear()) : Eigen::Matrix3d::Identity();
+    EXPECT_NEAR(std::abs(up->dot(R * Eigen::Vector3d::UnitY())), 1.0, 1e-9);
+
+    const KittiMetric v = kitti_metric(gt, climb);
+    ASSERT_GT(v.segments, 0u);
+    for (const auto& s : v.segment_errors) {
+      EXPECT_NEAR(s.vertical_ratio, 0.01 * (dist[s.last_frame] - dist[s.first_frame]) / s.length_m, 1e-9);
+      EXPECT_NEAR(s.horizontal_ratio, 0.0, 1e-9);
+    }
+    EXPECT_NEAR(v.t_err_vertical_pct, v.t_err_pct, 1e-9);
+    EXPECT_GT(v.t_err_vertical_pct, 1.0);  // segments run a frame past their length
+    EXPECT_NEAR(v.t_err_horizontal_pct, 0.0, 1e-9);
+
+    const KittiMetric h = kitti_metric(gt, wide);
+    for (const auto& s : h.segment_errors) {
+      EXPECT_NEAR(s.vertical_ratio, 0.0, 1e-9);
+      EXPECT_NEAR(s.horizontal_ratio, s.t_err_ratio, 1e-9);
+    }
+    EXPECT_NEAR(h.t_err_horizontal_pct, h.t_err_pct, 1e-9);
+    EXPECT_GT(h.t_err_horizontal_pct, 0.9);
+  }
+}
+
+TEST(KittiMetricSplit, AStraightDriveGivesNoUp) {
+  const PoseList gt = straight_path(1500, 1.0);
+  EXPECT_FALSE(ground_truth_up(gt).has_value());
+  PoseList est = gt;
+  for (auto& T : est) T.translation() *= 1.01;
+  const KittiMetric m = kitti_metric(gt, est);
+  ASSERT_GT(m.segments, 0u);
+  EXPECT_NEAR(m.t_err_pct, 1.0, 0.01);  // segments run a frame past their length
+  EXPECT_TRUE(std::isnan(m.t_err_vertical_pct));
+  EXPECT_TRUE(std::isnan(m.t_err_horizontal_pct));
+  EXPECT_TRUE(std::isnan(m.segment_errors.front().vertical_ratio));
 }
 
 }  // namespace

@@ -43,7 +43,8 @@ TEST(EvalReport, JsonHasEveryField) {
                           "path_length_m", "per_length", "ate_rmse_m", "ate_mean_m",
                           "ate_median_m", "ate_max_m", "rpe_pairs", "rpe_trans_rmse_m",
                           "rpe_trans_mean_m", "rpe_rot_rmse_deg", "rpe_rot_mean_deg", "note",
-                          "gt", "est", "association", "gt_poses", "est_poses"})
+                          "gt", "est", "association", "gt_poses", "est_poses",
+                          "t_err_horizontal_pct", "t_err_vertical_pct"})
     EXPECT_TRUE(j.contains(key)) << key;
   EXPECT_EQ(j["frames"].get<int>(), 700);
   EXPECT_NEAR(j["t_err_pct"].get<double>(), r.kitti.t_err_pct, 1e-12);
@@ -59,6 +60,10 @@ TEST(EvalReport, JsonHasEveryField) {
   EXPECT_NE(table.find("t_err"), std::string::npos);
   EXPECT_NE(table.find("ATE"), std::string::npos);
   EXPECT_NE(table.find("     800"), std::string::npos);
+  // A scale error of a level loop is all horizontal.
+  EXPECT_NEAR(j["t_err_horizontal_pct"].get<double>(), r.kitti.t_err_pct, 1e-9);
+  EXPECT_NEAR(j["t_err_vertical_pct"].get<double>(), 0.0, 1e-9);
+  EXPECT_NE(table.find("horizontal"), std::string::npos);
 }
 
 TEST(EvalReport, ShortPathGivesNullNotZero) {
@@ -73,6 +78,7 @@ TEST(EvalReport, ShortPathGivesNullNotZero) {
   EXPECT_TRUE(j["t_err_pct"].is_null());
   EXPECT_TRUE(j["r_err_deg_per_100m"].is_null());
   EXPECT_TRUE(j["per_length"][0]["t_err_pct"].is_null());
+  EXPECT_TRUE(j["t_err_vertical_pct"].is_null());
   EXPECT_EQ(j["kitti_segments"].get<int>(), 0);
   EXPECT_NE(j["note"].get<std::string>().find("shorter than"), std::string::npos);
   EXPECT_NE(format_eval_table(r).find("n/a"), std::string::npos);

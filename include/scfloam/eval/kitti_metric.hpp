@@ -4,8 +4,10 @@
 // lidar-frame estimate against camera-frame ground truth is meaningless (docs/evaluation.md).
 #pragma once
 
+#include <Eigen/Core>
 #include <array>
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -24,6 +26,9 @@ struct KittiSegmentError {
   double length_m = 0;
   double t_err_ratio = 0;     // ||t(E)|| / length (devkit's t_err: multiply by 100 for %)
   double r_err_rad_per_m = 0; // angle(R(E)) / length
+  // t(E) in the ground truth's world frame, split along its up (vertical) and across it
+  // (horizontal), each / length; NaN when the ground truth gives no up.
+  double vertical_ratio = 0, horizontal_ratio = 0;
 };
 
 struct KittiLengthError {
@@ -40,6 +45,11 @@ struct KittiMetric {
   double r_err_deg_per_100m = 0;
   std::size_t segments = 0;
   double path_length_m = 0;  // along the ground truth
+  // Means over every segment of |vertical| and |horizontal| error, in %, like t_err (not its
+  // parts: t_err is the mean of their root sum of squares). Loop closure removes the
+  // horizontal part; a sensor's elevation offset makes the vertical one (docs/evaluation.md).
+  // NaN without segments or without an up.
+  double t_err_vertical_pct = 0, t_err_horizontal_pct = 0;
   std::array<KittiLengthError, kKittiSegmentLengthsM.size()> per_length{};
   std::vector<KittiSegmentError> segment_errors;
   bool has_segments() const { return segments > 0; }
@@ -54,6 +64,12 @@ std::vector<double> trajectory_distances_m(const PoseList& poses);
 // path ends before (devkit lastFrameFromSegmentLength).
 long last_frame_from_segment_length(const std::vector<double>& dist_m, std::size_t first_frame,
                                     double length_m);
+
+// The ground truth's up, up to its sign: the normal of the plane its positions span (a vehicle
+// drives on a near-horizontal surface, whatever frame convention the poses use: camera 0's y
+// down or a LiDAR's z up). None when they span no plane (a straight line, a standstill): the
+// second-smallest spread must be 5 m or more (RMS) and the smallest at most a quarter of it.
+std::optional<Eigen::Vector3d> ground_truth_up(const PoseList& gt);
 
 // Throws scfloam::Error when the two lists differ in length or are empty (the devkit needs a
 // pose for every frame).
