@@ -95,8 +95,13 @@ void print_report(const nlohmann::json& summary) {
                   a["ate_rmse_m"].get<double>());
       return;
     }
-    std::printf("%-10s t_err %.3f %%  r_err %.4f deg/100m  ATE %.3f m  (KITTI metric vs ground truth)\n",
-                name, a["t_err_pct"].get<double>(), a["r_err_deg_per_100m"].get<double>(),
+    // The horizontal / vertical parts (eval's split; absent when the ground truth spans no plane).
+    char split[96] = "";
+    if (a.contains("t_err_vertical_pct") && a["t_err_vertical_pct"].is_number())
+      std::snprintf(split, sizeof split, " (horizontal %.3f, vertical %.3f)",
+                    a["t_err_horizontal_pct"].get<double>(), a["t_err_vertical_pct"].get<double>());
+    std::printf("%-10s t_err %.3f %%%s  r_err %.4f deg/100m  ATE %.3f m  (KITTI metric vs ground truth)\n",
+                name, a["t_err_pct"].get<double>(), split, a["r_err_deg_per_100m"].get<double>(),
                 a["ate_rmse_m"].get<double>());
   };
   if (summary.contains("odometry_accuracy")) accuracy_line("odometry", summary["odometry_accuracy"]);
