@@ -74,8 +74,10 @@ KittiMetric kitti_metric(const PoseList& gt, const PoseList& est) {
       s.t_err_ratio = E.translation().norm() / len;
       s.r_err_rad_per_m = rotation_angle_rad(E.linear()) / len;
       if (up) {
-        // t(E) is in the last frame's axes: turned into the world's to split it.
-        const Eigen::Vector3d error_world = gt[last].linear() * E.translation();
+        // t(E) = R(delta_est)^T d with d = t(delta_gt) - t(delta_est) in the first frame's
+        // axes: the same vector (same norm) turned into the world's by the first pose.
+        const Eigen::Vector3d error_world =
+            gt[first].linear() * (delta_gt.translation() - delta_est.translation());
         const double vertical = error_world.dot(*up);
         s.vertical_ratio = std::abs(vertical) / len;
         s.horizontal_ratio = (error_world - vertical * *up).norm() / len;
