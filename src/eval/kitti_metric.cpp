@@ -43,7 +43,37 @@ std::optional<Eigen::Vector3d> ground_truth_up(const PoseList& gt) {
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);  // ascending
   const Eigen::Vector3d spread = eig.eigenvalues().cwiseMax(0.0).cwiseSqrt();
   if (!(spread(1) >= 5.0) || !(spread(0) <= 0.25 * spread(1))) return std::nullopt;
-  return eig.eigenvectors().col(0).normalized();
+  const Eigen::Vector3d normal = eig.eigenvectors().col(0);
+  // The plane only says which of the vehicle's axes points up: the world's up is that axis
+  // averaged over the drive (a hilly route tilts the plane of the positions by several
+  // degrees; the vehicle's mean up does not tilt with it).
+  Eigen::Vector3d up = Eigen::Vector3d::Zero();
+  double best = -1;
+  for (int k = 0; k < 3; ++k) {
+    Eigen::Vector3d axis = Eigen::Vector3d::Zero();
+    for (const Pose& p : gt) axis += p.linear().col(k);
+    axis /= static_cast<double>(gt.size());
+    const double along = std::abs(axis.dot(normal));
+    if (along > best) best = along, up = axis;
+  }
+  if (!(up.norm() > 0.5)) return std::nullopt;  // the axis turned over: no steady up
+  up.normalize();
+  // A drive that never turns (a straight road over a crest) spans a plane that is not the
+  // ground's: its directions of travel, across the up found, must scatter (8 deg RMS or more).
+  Eigen::Matrix3d directions = Eigen::Matrix3d::Zero();
+  double travelled = 0;
+  for (std::size_t i = 1; i < gt.size(); ++i) {
+    Eigen::Vector3d step = gt[i].translation() - gt[i - 1].translation();
+    step -= step.dot(up) * up;
+    const double length = step.norm();
+    if (!(length > 1e-6)) continue;
+    directions += (step / length) * (step / length).transpose() * length;
+    travelled += length;
+  }
+  if (!(travelled > 0)) return std::nullopt;
+  const Eigen::Vector3d scatter = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(directions / travelled).eigenvalues();
+  if (!(scatter(1) >= 0.02)) return std::nullopt;  // scatter(0) is along up, ~0
+  return up;
 }
 
 KittiMetric kitti_metric(const PoseList& gt, const PoseList& est) {

@@ -61,11 +61,11 @@ std::string format_eval_table(const EvalReport& r) {
   if (!r.kitti.note.empty()) out += "  note: " + r.kitti.note + "\n";
   if (r.kitti.has_segments()) {
     if (std::isfinite(r.kitti.t_err_vertical_pct)) {
-      std::snprintf(line, sizeof line, "  t_err across the ground truth's up: horizontal %s %%, vertical %s %%\n",
+      std::snprintf(line, sizeof line, "  t_err split by the ground truth's up: horizontal %s %%, vertical %s %% (means of |part| / length)\n",
                     fixed(r.kitti.t_err_horizontal_pct, 3).c_str(), fixed(r.kitti.t_err_vertical_pct, 3).c_str());
       out += line;
     } else {
-      out += "  t_err split: n/a (the ground truth spans no plane to take its up from)\n";
+      out += "  t_err split: n/a (the ground truth spans no plane, or never turns, to take its up from)\n";
     }
   }
   out += "\nATE after SE(3) Umeyama alignment [m]\n";

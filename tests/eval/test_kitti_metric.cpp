@@ -237,6 +237,37 @@ TEST(KittiMetricSplit, VerticalAndHorizontalErrorsAlongTheGroundTruthsUp) {
   }
 }
 
+TEST(KittiMetricSplit, ARotationErrorIsSplitInTheWorldsAxes) {
+  // The estimate pitched by theta about camera 0's x at every pose of a level drive:
+  // t(delta_est) = Q^T t(delta_gt), so the error d = (I - Q^T) t(delta_gt) has |t_z| sin(theta)
+  // along up (y) and |t_z| (1 - cos(theta)) across it, in the first frame's axes, which a yaw
+  // leaves. Turning t(E) by the wrong pose (the last instead of first * delta_est) misses the
+  // horizontal part by ~1e-5 per segment.
+  const double theta = 0.01;
+  const PoseList gt = curved_path(1200, 0.003);
+  PoseList est = gt;
+  Pose Q = Pose::Identity();
+  Q.linear() = so3_exp(Eigen::Vector3d(theta, 0, 0));
+  for (Pose& T : est) T = T * Q;
+  const KittiMetric m = kitti_metric(gt, est);
+  ASSERT_GT(m.segments, 0u);
+  for (const auto& s : m.segment_errors) {
+    const double tz = std::abs((gt[s.first_frame].inverse() * gt[s.last_frame]).translation().z());
+    EXPECT_NEAR(s.vertical_ratio, std::sin(theta) * tz / s.length_m, 1e-12);
+    EXPECT_NEAR(s.horizontal_ratio, (1 - std::cos(theta)) * tz / s.length_m, 1e-12);
+  }
+}
+
+TEST(KittiMetricSplit, AStraightRoadOverACrestGivesNoUp) {
+  // Its positions span a vertical plane (8 m of climb and descent, no lateral spread): the
+  // plane's normal is the car's lateral axis, and the drive never turns about it.
+  PoseList gt = straight_path(1500, 1.0);
+  for (std::size_t i = 0; i < gt.size(); ++i)
+    gt[i].translation().y() = -8.0 * std::sin(M_PI * static_cast<double>(i) / 1500.0);
+  EXPECT_FALSE(ground_truth_up(gt).has_value());
+  EXPECT_TRUE(std::isnan(kitti_metric(gt, gt).t_err_vertical_pct));
+}
+
 TEST(KittiMetricSplit, AStraightDriveGivesNoUp) {
   const PoseList gt = straight_path(1500, 1.0);
   EXPECT_FALSE(ground_truth_up(gt).has_value());

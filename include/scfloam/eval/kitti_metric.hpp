@@ -46,7 +46,7 @@ struct KittiMetric {
   std::size_t segments = 0;
   double path_length_m = 0;  // along the ground truth
   // Means over every segment of |vertical| and |horizontal| error, in %, like t_err (not its
-  // parts: t_err is the mean of their root sum of squares). Loop closure removes the
+  // parts: t_err is the mean of their root sum of squares). Loop closure reduces the
   // horizontal part; a sensor's elevation offset makes the vertical one (docs/evaluation.md).
   // NaN without segments or without an up.
   double t_err_vertical_pct = 0, t_err_horizontal_pct = 0;
@@ -65,10 +65,12 @@ std::vector<double> trajectory_distances_m(const PoseList& poses);
 long last_frame_from_segment_length(const std::vector<double>& dist_m, std::size_t first_frame,
                                     double length_m);
 
-// The ground truth's up, up to its sign: the normal of the plane its positions span (a vehicle
-// drives on a near-horizontal surface, whatever frame convention the poses use: camera 0's y
-// down or a LiDAR's z up). None when they span no plane (a straight line, a standstill): the
-// second-smallest spread must be 5 m or more (RMS) and the smallest at most a quarter of it.
+// The ground truth's up, up to its sign, whatever its axis convention (camera 0's y down or a
+// LiDAR's z up): the vehicle axis nearest the normal of the plane its positions span, averaged
+// over the drive. None when they span no plane (second-smallest spread under 5 m RMS, or the
+// smallest over a quarter of it: a straight line, a standstill) or the drive never turns (its
+// directions of travel across that up scatter by less than ~8 deg RMS: a straight road over a
+// crest, whose plane stands on edge).
 std::optional<Eigen::Vector3d> ground_truth_up(const PoseList& gt);
 
 // Throws scfloam::Error when the two lists differ in length or are empty (the devkit needs a
