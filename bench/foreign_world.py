@@ -8,10 +8,12 @@ ring road with gabled houses, hedges, tree rows and utility poles instead of a g
 32-beam sensor with 1 degree spacing (no scfloam preset, so the beams must be learned from the
 scans), mounted 1.85 m up, spinning clockwise, column-major points, intensity 0-255; raw sweeps
 (each column cast from the pose at its firing time, per-point `t` in seconds from the stamp);
-oncoming cars. Output: a folder of binary PCD scans named by their stamps, `times.txt`, and
-`gt_tum.txt` (sensor poses at the stamps, TUM format). numpy only.
+oncoming cars; per-beam calibration errors (elevation, azimuth, range bias). Output: a folder of
+binary PCD scans named by their stamps, `times.txt`, `gt_tum.txt` (sensor poses at the stamps,
+TUM format) and `beam_calibration.yaml` (the errors drawn). numpy only.
 
   /usr/bin/python3 bench/foreign_world.py --out DIR [--laps 2] [--seed 1] [--jobs 2]
+      [--frames N] [--perfect-calibration | --calibration-errors el,az,bias]
   scfloam run DIR -m optimized -o OUT --deterministic
   scfloam eval --gt DIR/gt_tum.txt --est OUT/poses_tum.txt
 """
@@ -553,8 +555,11 @@ def main():
         "%.9f %.6f %.6f %.6f %.9f %.9f %.9f %.9f\n" % (1.7e9 + t, *pi, *quat(Ri)) for t, Ri, pi in zip(stamps, R, p)))
     write_text(os.path.join(a.out, "times.txt"), "".join("%.9f\n" % (1.7e9 + t) for t in stamps))
     # The calibration errors drawn, beam by beam from the top: the ground truth of a calibration.
+    # A beam's true elevation / azimuth is its nominal one plus its offset; its reported range
+    # is the true range plus its bias.
     fmt = lambda v: "[" + ", ".join("%.6g" % x for x in v) + "]"
     write_text(os.path.join(a.out, "beam_calibration.yaml"),
+               "# true elevation / azimuth = nominal + offset; reported range = true range + bias\n"
                "elevation_deg: %s\nelevation_offset_deg: %s\nazimuth_offset_deg: %s\nrange_bias_m: %s\n"
                % (fmt(BEAMS_DEG), fmt(np.degrees(calib["el"])), fmt(np.degrees(calib["az"])), fmt(calib["bias"])))
     print("foreign_world: road %.0f m, %d houses/hedges/cars, %d trunks and poles, %d crowns, %d frames (%.0f s)"

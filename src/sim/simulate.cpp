@@ -180,6 +180,7 @@ void simulate_sequence(const SimConfig& config, const fs::path& out_dir, bool pr
       for (std::size_t b = 0; b < v.size(); ++b) out << (b ? ", " : "") << v[b] * scale;
       out << "]\n";
     };
+    out << "# true elevation / azimuth = nominal + offset; reported range = true range + bias\n";
     out << "beam_calibration:\n";
     list("elevation_deg", sensor.elevations_deg, 1.0);
     list("elevation_offset_deg", calib.elevation_offset_rad, 180.0 / M_PI);

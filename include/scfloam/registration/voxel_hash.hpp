@@ -34,8 +34,8 @@ class FlatKeyIndex {
 
   // The load past which the table grows: half (the default, short probes) or three quarters
   // (a third fewer slots for tables of millions of keys built once, such as map.pcd's). An
-  // enum, not a number: 0 would make reset() loop forever and a full table would make
-  // insert() probe forever.
+  // enum, not a number: 0 would make reset() loop forever, and at a full load find() of a
+  // missing key would probe forever (insert() too, past it).
   enum class MaxLoad : unsigned { kHalf = 2, kThreeQuarters = 3 };
   explicit FlatKeyIndex(MaxLoad max_load = MaxLoad::kHalf)
       : max_load_quarters_(static_cast<unsigned>(max_load)) {}
