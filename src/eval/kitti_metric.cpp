@@ -47,15 +47,12 @@ std::optional<Eigen::Vector3d> ground_truth_up(const PoseList& gt) {
   // The plane only says which of the vehicle's axes points up: the world's up is that axis
   // averaged over the drive (a hilly route tilts the plane of the positions by several
   // degrees; the vehicle's mean up does not tilt with it).
-  Eigen::Vector3d up = Eigen::Vector3d::Zero();
-  double best = -1;
-  for (int k = 0; k < 3; ++k) {
-    Eigen::Vector3d axis = Eigen::Vector3d::Zero();
-    for (const Pose& p : gt) axis += p.linear().col(k);
-    axis /= static_cast<double>(gt.size());
-    const double along = std::abs(axis.dot(normal));
-    if (along > best) best = along, up = axis;
-  }
+  Eigen::Matrix3d mean_axes = Eigen::Matrix3d::Zero();  // column k: vehicle axis k, averaged
+  for (const Pose& p : gt) mean_axes += p.linear();
+  mean_axes /= static_cast<double>(gt.size());
+  Eigen::Index k = 0;
+  (mean_axes.transpose() * normal).cwiseAbs().maxCoeff(&k);
+  Eigen::Vector3d up = mean_axes.col(k);
   if (!(up.norm() > 0.5)) return std::nullopt;  // the axis turned over: no steady up
   up.normalize();
   // A drive that never turns (a straight road over a crest) spans a plane that is not the
