@@ -26,6 +26,25 @@ struct PreprocessConfig {
   // agree, their median ratio of mean residuals 5 % off 1), and keeps that one; undecided
   // after 100 such frames (or 300 frames in all), it keeps deskew.
   bool deskew_check = true;
+  // Scans without per-point times (KITTI-style .bin, older Velodyne drivers, exported PCD
+  // folders) get them from the azimuth when deskew is on: the point order gives the sweep's
+  // direction and seam (features/sweep_times.hpp), times count from the sweep's middle. A
+  // cloud whose order shows no sweep keeps no times (and is not deskewed).
+  bool deskew_times_from_azimuth = true;
+  // The sweep's duration for those times; 0: the interval between the scans' stamps (0.1 s
+  // until two stamps 0.02-0.25 s apart are seen; a longer gap keeps the last interval).
+  double sweep_period_s = 0;
+  // With deskew: a frame whose solved motion differs from the last interval's (by which the
+  // sweep was deskewed) enough to move the sweep's ends by these amounts is deskewed again
+  // at its own velocity and solved once more (a turn starting or ending, a spinning robot,
+  // a hand-held sensor, hard braking; docs/odometry.md, "Session 38").
+  bool redeskew = true;
+  double redeskew_min_rotation_deg = 0.2;
+  double redeskew_min_translation_m = 0.02;
+  // Where in its sweep a scan without point times is stamped, for those times: "middle"
+  // (KITTI, the simulator's default), "start" (Ouster, Hesai) or "end" (Velodyne's ROS
+  // driver). Wrong, the poses are reported up to a sweep off in time, not distorted.
+  std::string sweep_stamp = "middle";
   // Raises every feature point's elevation by this angle (degrees). KITTI's HDL-64E scans
   // report beams about 0.22 deg too low (IMLS-SLAM, Deschaud 2018; CT-ICP uses 0.205), which
   // bends the trajectory into a bowl: a steady pitch drift no loop closure can see. 0.22 is

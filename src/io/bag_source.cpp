@@ -203,7 +203,7 @@ InputInfo inspect_bag(const fs::path& path, const ScanSourceOptions& options) {
     const std::string time_field = point_time_field(first.fields);
     if (!scan.has_time)
       info.notes.push_back(time_field.empty()
-                               ? "no per-point time field (no deskew from the source)"
+                               ? "no per-point time field"
                                : "per-point time field '" + time_field +
                                      "' ignored: its values are not times within 1.5 s of the stamp");
     if (scan.points.size() < first.width * std::size_t{first.height})

@@ -34,6 +34,12 @@ std::vector<Binding> bindings(SlamConfig& c) {
       {pre, "max_range_m", &o.preprocess.max_range_m},
       {pre, "deskew", &o.preprocess.deskew},
       {pre, "deskew_check", &o.preprocess.deskew_check},
+      {pre, "deskew_times_from_azimuth", &o.preprocess.deskew_times_from_azimuth},
+      {pre, "sweep_period_s", &o.preprocess.sweep_period_s},
+      {pre, "sweep_stamp", &o.preprocess.sweep_stamp},
+      {pre, "redeskew", &o.preprocess.redeskew},
+      {pre, "redeskew_min_rotation_deg", &o.preprocess.redeskew_min_rotation_deg},
+      {pre, "redeskew_min_translation_m", &o.preprocess.redeskew_min_translation_m},
       {pre, "elevation_check", &o.preprocess.elevation_check},
       {pre, "elevation_correction_deg", &o.preprocess.elevation_correction_deg},
       {pre, "online_elevation_calibration", &o.preprocess.online_elevation_calibration},
@@ -225,6 +231,12 @@ void check_ranges(const SlamConfig& c, const std::filesystem::path& path) {
       require(false, "odometry.rings.lidar", "auto, hdl64, hdl32, vlp16, os1-64 or os1-128 (got `" + o.rings.lidar + "`)");
     }
   }
+  require(o.preprocess.sweep_period_s == 0 || (o.preprocess.sweep_period_s >= 0.005 && o.preprocess.sweep_period_s <= 1),
+          "odometry.preprocess.sweep_period_s", "0 (from the stamps) or in [0.005, 1] s");
+  require(o.preprocess.sweep_stamp == "start" || o.preprocess.sweep_stamp == "middle" || o.preprocess.sweep_stamp == "end",
+          "odometry.preprocess.sweep_stamp", "start, middle or end (got `" + o.preprocess.sweep_stamp + "`)");
+  require(o.preprocess.redeskew_min_rotation_deg >= 0, "odometry.preprocess.redeskew_min_rotation_deg", ">= 0");
+  require(o.preprocess.redeskew_min_translation_m >= 0, "odometry.preprocess.redeskew_min_translation_m", ">= 0");
   require(o.rings.min_points_per_ring >= 0, "odometry.rings.min_points_per_ring", ">= 0");
   require(o.features.curvature_half_window >= 1, "odometry.features.curvature_half_window", ">= 1");
   require(o.features.sectors_per_ring >= 1, "odometry.features.sectors_per_ring", ">= 1");

@@ -190,7 +190,7 @@ InputInfo inspect_file_list(const ScanFileList& list, const ScanSourceOptions& o
                          " points of the first scan have NaN coordinates (organized cloud) and are dropped");
   if (!first.scan.has_ring)
     info.notes.push_back("no ring field: rings come from each point's elevation (pick the sensor preset)");
-  if (!first.scan.has_time) info.notes.push_back("no per-point time field: scans are not deskewed");
+  if (!first.scan.has_time) info.notes.push_back("no per-point time field");
   return info;
 }
 

@@ -1,10 +1,12 @@
 #include "scfloam/io/input_inspect.hpp"
 
+#include <cmath>
 #include <cstdio>
 #include <utility>
 #include <nlohmann/json.hpp>
 
 #include "scfloam/features/beam_layout.hpp"
+#include "scfloam/features/sweep_times.hpp"
 #include "scfloam/io/bag_source.hpp"
 #include "scfloam/io/folder_source.hpp"
 #include "scfloam/io/kitti.hpp"
@@ -42,15 +44,30 @@ InputInfo inspect_kitti(const fs::path& dir) {
   info.notes.push_back(seq.calib().has_Tr ? "calib.txt has Tr: poses_kitti.txt in camera-0 convention by default"
                                           : "no Tr in calib.txt: poses in the lidar frame (--frame camera refused)");
   if (!first.has_ring && !first.has_time)
-    info.notes.push_back("no ring or time fields: rings from elevation, no deskew");
+    info.notes.push_back("no ring or time fields: rings from elevation");
   else if (!first.has_time)
-    info.notes.push_back("ring field, no time field: no deskew");
+    info.notes.push_back("ring field, no time field");
   else
     info.notes.push_back(std::string(first.has_ring ? "ring and time fields" : "time field, no ring field") +
                          ": deskewed when the config says so (preprocess.deskew)");
   return info;
 }
 
+
+// What deskew would do with scans that carry no point times: times from the azimuth when the
+// point order shows the sweep (features/sweep_times.hpp), else none.
+std::string azimuth_times_note(const Scan& first) {
+  const SweepLayout sweep = sweep_layout(first.points);
+  if (!sweep.usable)
+    return "no per-point times, and the point order shows no sweep (" + sweep.why + "): not deskewed";
+  char line[256];
+  std::snprintf(line, sizeof line,
+                "no per-point times: where deskewed (the raw sensors' presets), from the azimuth: %s, turning "
+                "%s, seam at %.1f deg",
+                sweep.ring_major ? "beam by beam" : "column by column",
+                sweep.clockwise ? "clockwise" : "counterclockwise", sweep.seam_rad * 180 / M_PI);
+  return line;
+}
 
 // The beams of the first scan (src/features/beam_layout.cpp) and the ring tables that fit
 // them, so that a user with an unfamiliar sensor knows which --sensor to pass.
@@ -97,7 +114,9 @@ InputInfo inspect_input(const fs::path& path, const ScanSourceOptions& options) 
   if (info.scans > 0) {
     const auto source = open_scan_source(path, options);
     if (source->size() > 0) {
-      describe_beams(source->load(0), info);
+      const Scan first = source->load(0);
+      describe_beams(first, info);
+      if (!first.has_time) info.notes.push_back(azimuth_times_note(first));
       const SensorGuess guess = guess_sensor(*source);
       info.notes.push_back("sensor: `scfloam run` without --sensor uses " + guess.preset + " (" + guess.reason + ")");
     }

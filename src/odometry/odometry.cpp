@@ -7,6 +7,7 @@
 
 #include "scfloam/error.hpp"
 #include "scfloam/features/deskew.hpp"
+#include "scfloam/features/sweep_times.hpp"
 #include "scfloam/features/feature_extractor.hpp"
 #include "scfloam/odometry/elevation_calibration.hpp"
 #include "scfloam/odometry/ground_elevation.hpp"
@@ -38,6 +39,11 @@ struct Odometry::Impl {
   ScanToMapRegistration registration;
 
   std::vector<LidarPoint> deskewed;
+  // Scans without point times, deskewed: times from the azimuth (PreprocessConfig::
+  // deskew_times_from_azimuth), over a sweep as long as the scans' stamps are apart.
+  double sweep_period_s = 0.1;
+  std::optional<double> last_stamp_s;
+  std::optional<SweepLayout> azimuth_layout;  // the last such scan's
   // Frames 0 and 1 come before there is a velocity to deskew with: their raw points and poses
   // are kept so that frame 2 can put them into the map again, deskewed.
   std::vector<LidarPoint> early_points[2];
@@ -199,12 +205,28 @@ const RingLayoutInfo& Odometry::ring_layout() const { return impl_->extractor.ri
 
 const SettingCheck& Odometry::deskew_check() const { return impl_->deskew_check; }
 bool Odometry::deskews() const { return impl_->config.preprocess.deskew; }
+const std::optional<SweepLayout>& Odometry::azimuth_times() const { return impl_->azimuth_layout; }
 const SettingCheck& Odometry::elevation_check() const { return impl_->elevation_check; }
 bool Odometry::may_revise() const { return impl_->trial != Impl::Trial::kNone || impl_->frame0_result; }
 
 OdometryResult Odometry::process(const Scan& scan) {
   Impl& s = *impl_;
   const PreprocessConfig& p = s.config.preprocess;
+  if (p.deskew && p.deskew_times_from_azimuth && !scan.has_time) {
+    const double interval = s.last_stamp_s ? scan.timestamp_s - *s.last_stamp_s : 0.0;
+    if (interval >= 0.02 && interval <= 0.25) s.sweep_period_s = interval;
+    s.last_stamp_s = scan.timestamp_s;
+    if (p.sweep_period_s > 0) s.sweep_period_s = p.sweep_period_s;
+    Scan timed = scan;
+    // The last scan's seam serves where this one's is unclear (drivers cut at a fixed azimuth).
+    const std::optional<SweepLayout> earlier = s.azimuth_layout;
+    s.azimuth_layout = assign_times_from_azimuth(timed.points, s.sweep_period_s, sweep_stamp_fraction(p.sweep_stamp),
+                                                 earlier ? &*earlier : nullptr);
+    if (s.azimuth_layout->usable) {
+      timed.has_time = true;
+      return process(timed);
+    }
+  }
   if (s.frames == 0) {
     if (p.deskew) {
       s.deskew_check.verdict = p.deskew_check ? "no per-point times" : "unchecked";
@@ -443,6 +465,33 @@ OdometryResult Odometry::process_frame(const Scan& scan) {
           if (matched(other) && (!matched(reg) || other.mean_residual_m < reg.mean_residual_m))
             reg = other;
         }
+    }
+    // The sweep was deskewed at the last interval's velocity. Where the motion changed over
+    // this interval (a turn starting or ending, a robot's spin, a hand-held sensor, hard
+    // braking), the sweep keeps the difference as distortion: at 4 deg per frame of change
+    // the solve fails (docs/odometry.md, "Session 38"). Deskewed again at the velocity just
+    // solved and solved once more from there.
+    const double interval_s = time_s - s.last_time_s;
+    if (deskew && s.frames >= 2 && s.delta_dt_s > 0 && interval_s > 0 && !gap && c.preprocess.redeskew) {
+      const Eigen::Isometry3d solved = s.T_last.inverse() * reg.T_world_lidar;
+      const Eigen::Vector3d omega = so3_log(solved.linear()) / interval_s;
+      const Eigen::Vector3d velocity = solved.translation() / interval_s;
+      const Eigen::Vector3d omega_used = so3_log(s.T_delta.linear()) / s.delta_dt_s;
+      const Eigen::Vector3d velocity_used = s.T_delta.translation() / s.delta_dt_s;
+      // What the difference moves a point at the sweep's ends (a sweep lasts about an interval).
+      const double half_sweep_s = 0.5 * interval_s;
+      if ((omega - omega_used).norm() * half_sweep_s > c.preprocess.redeskew_min_rotation_deg * M_PI / 180 ||
+          (velocity - velocity_used).norm() * half_sweep_s > c.preprocess.redeskew_min_translation_m) {
+        Stopwatch again;
+        s.deskewed = scan.points;
+        deskew_constant_velocity(s.deskewed, omega, velocity, reference_s);
+        s.extractor.extract(s.deskewed, scan.has_ring && c.rings.use_ring_field, s.raw_edges, nullptr);
+        s.edge_filter.filter(s.raw_edges, c.features.edge_leaf_m, result.edges);
+        s.plane_filter.filter_runs(s.extractor.plane_runs(), result.planes);
+        result.features_ms += again.elapsed_ms();
+        reg = registration.align(result.edges, result.planes, s.map, reg.T_world_lidar, s.rounds);
+        result.redeskewed = true;
+      }
     }
     result.T_world_lidar = orthonormalized(reg.T_world_lidar);
     result.degenerate = reg.degenerate;

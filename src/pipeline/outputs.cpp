@@ -13,6 +13,7 @@
 #include "scfloam/error.hpp"
 #include "scfloam/eval/report.hpp"
 #include "scfloam/features/deskew.hpp"
+#include "scfloam/features/sweep_times.hpp"
 #include "scfloam/io/kitti.hpp"
 #include "scfloam/io/point_cloud_file.hpp"
 #include "scfloam/io/trajectory.hpp"
@@ -121,6 +122,10 @@ std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> frame_velocity(const 
 std::vector<LidarPoint> keyframe_cloud(const ScanSource& source, const RunResult& result, std::size_t frame,
                                        const OutputOptions& options) {
   Scan scan = source.load(frame);
+  if (result.deskewed_scans && !scan.has_time && result.azimuth_times && result.azimuth_times->usable)
+    scan.has_time = assign_times_from_azimuth(scan.points, result.azimuth_times->sweep_period_s,
+                                              result.azimuth_times->stamp_fraction, &*result.azimuth_times)
+                        .usable;
   if (result.deskewed_scans && scan.has_time)
     if (const auto velocity = frame_velocity(result, frame))
       deskew_constant_velocity(scan.points, velocity->first, velocity->second);
@@ -187,6 +192,21 @@ nlohmann::json make_summary(const ScanSource& source, const RunResult& result) {
     return out;
   };
   summary["deskew"] = check_json(result.deskew_check);
+  summary["deskew"]["redeskewed_frames"] = result.redeskewed_frames;
+  if (const auto& sweep = result.azimuth_times) {
+    // Scans without point times: whether their order gave times from the azimuth.
+    nlohmann::json times = {{"from", "azimuth"}, {"usable", sweep->usable}};
+    if (sweep->usable) {
+      times["turn"] = sweep->clockwise ? "clockwise" : "counterclockwise";
+      times["order"] = sweep->ring_major ? "beam by beam" : "column by column";
+      times["seam_deg"] = sweep->seam_rad * 180 / M_PI;
+      times["sweep_period_s"] = sweep->sweep_period_s;
+      times["stamp_fraction"] = sweep->stamp_fraction;
+    } else {
+      times["why_not"] = sweep->why;
+    }
+    summary["deskew"]["times"] = times;
+  }
   summary["elevation_check"] = check_json(result.elevation_check);
   nlohmann::json rings = {{"source", result.ring_layout.source}, {"beams", result.ring_layout.beams}};
   if (result.ring_layout.source == "learned") {

@@ -251,12 +251,14 @@ class OdometryStage {
       result.timing_ms["map_rebuild"].push_back(watch.elapsed_ms());
     }
     OdometryResult odom = odometry_.process(scan);
+    if (odom.redeskewed) ++result.redeskewed_frames;
     result.stamps_s.push_back(scan.timestamp_s);
     result.timing_ms["features"].push_back(odom.features_ms);
     result.timing_ms["registration"].push_back(odom.registration_ms);
     result.deskew_check = odometry_.deskew_check();
     result.elevation_check = odometry_.elevation_check();
     result.deskewed_scans = odometry_.deskews();
+    result.azimuth_times = odometry_.azimuth_times();
     if (result.stamps_s.size() == 1 || result.ring_layout.source != odometry_.ring_layout().source)
       result.ring_layout = odometry_.ring_layout();
 

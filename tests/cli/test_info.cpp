@@ -3,8 +3,11 @@
 
 #include "cli/run_cli.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <random>
 #include <nlohmann/json.hpp>
 
 #include "scfloam/io/point_cloud_file.hpp"
@@ -41,6 +44,32 @@ TEST(CliInfo, PcdFolderTextAndJson) {
   EXPECT_DOUBLE_EQ(j["end_time_s"].get<double>(), 0.2);
   EXPECT_TRUE(j["notes"].is_array());
   EXPECT_TRUE(j["topics"].is_array());
+}
+
+// Scans without point times: info says what deskew would take from their azimuths.
+TEST(CliInfo, ScansWithoutTimesShowTheirSweep) {
+  const fs::path dir = test::scratch_dir("cli_info_sweep");
+  std::vector<LidarPoint> sweep;  // 16 beams, 900 columns, clockwise from 90 deg
+  for (int c = 0; c < 900; ++c)
+    for (int b = 0; b < 16; ++b) {
+      const double az = (90.0 - 0.4 * c) * M_PI / 180, el = (-15.0 + 2.0 * b) * M_PI / 180, r = 10.0 + (c % 7);
+      LidarPoint p;
+      p.x = static_cast<float>(r * std::cos(el) * std::cos(az));
+      p.y = static_cast<float>(r * std::cos(el) * std::sin(az));
+      p.z = static_cast<float>(r * std::sin(el));
+      sweep.push_back(p);
+    }
+  for (int i = 0; i < 2; ++i) write_pcd(dir / ("s" + std::to_string(i) + ".pcd"), sweep, PcdEncoding::kBinary, false);
+  Outcome r = run_cli("info " + dir.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("from the azimuth: column by column, turning clockwise, seam at 90.0 deg"), std::string::npos)
+      << r.output;
+  // Shuffled, the same points show no sweep.
+  std::shuffle(sweep.begin(), sweep.end(), std::mt19937(3));
+  write_pcd(dir / "s0.pcd", sweep, PcdEncoding::kBinary, false);
+  r = run_cli("info " + dir.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("the point order shows no sweep"), std::string::npos) << r.output;
 }
 
 TEST(CliInfo, KittiSequence) {

@@ -71,6 +71,16 @@ TEST(Config, UnknownKeysAndWrongTypesAreErrorsNamingFileAndKey) {
   EXPECT_EQ(learned.odometry.rings.lidar, "auto");
   EXPECT_FALSE(learned.odometry.rings.adopt_learned_layout);
   expect_error_naming(dir / "missing.yaml", "cannot open");
+  write(dir / "stamp.yaml", "odometry:\n  preprocess:\n    sweep_stamp: sideways\n");
+  expect_error_naming(dir / "stamp.yaml", "odometry.preprocess.sweep_stamp");
+  write(dir / "period.yaml", "odometry:\n  preprocess:\n    sweep_period_s: 2.5\n");
+  expect_error_naming(dir / "period.yaml", "odometry.preprocess.sweep_period_s");
+  write(dir / "sweep.yaml",
+        "odometry:\n  preprocess:\n    sweep_stamp: end\n    sweep_period_s: 0.05\n    redeskew: false\n");
+  const SlamConfig sweep = load_config(dir / "sweep.yaml");
+  EXPECT_EQ(sweep.odometry.preprocess.sweep_stamp, "end");
+  EXPECT_DOUBLE_EQ(sweep.odometry.preprocess.sweep_period_s, 0.05);
+  EXPECT_FALSE(sweep.odometry.preprocess.redeskew);
 }
 
 TEST(Config, OnlineElevationCalibrationGainIsChecked) {

@@ -5,11 +5,13 @@
 
 #include <Eigen/Core>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "scfloam/config.hpp"
 #include "scfloam/features/feature_extractor.hpp"
+#include "scfloam/features/sweep_times.hpp"
 #include "scfloam/types.hpp"
 
 namespace scfloam {
@@ -18,6 +20,9 @@ struct OdometryResult {
   Eigen::Isometry3d T_world_lidar = Eigen::Isometry3d::Identity();
   FeatureCloud edges;   // downsampled edge features, lidar frame (after deskew)
   FeatureCloud planes;  // downsampled plane features, lidar frame (after deskew)
+  // Deskewed a second time at the velocity of this frame's own solve, and solved again
+  // (PreprocessConfig::redeskew).
+  bool redeskewed = false;
   double features_ms = 0;      // preprocessing + feature extraction
   double registration_ms = 0;  // prediction + scan-to-map + map update
   bool degenerate = false;     // the solve was poorly constrained in some direction
@@ -81,6 +86,9 @@ class Odometry {
   bool deskews() const;
   const SettingCheck& deskew_check() const;
   const SettingCheck& elevation_check() const;
+  // For scans without point times, deskewed: the last one's sweep as its order showed it
+  // and the times it was given (when usable); nullopt before any such scan.
+  const std::optional<SweepLayout>& azimuth_times() const;
   // The frames returned since some point may still be revised (OdometryResult::revised): a
   // setting check is measuring, or frame 0 waits for frame 1.
   bool may_revise() const;

@@ -12,6 +12,7 @@
 
 #include "scfloam/config.hpp"
 #include "scfloam/features/feature_extractor.hpp"
+#include "scfloam/features/sweep_times.hpp"
 #include "scfloam/io/scan_source.hpp"
 #include "scfloam/loop/loop_candidate.hpp"
 #include "scfloam/odometry/odometry.hpp"
@@ -91,6 +92,10 @@ struct RunResult {
   // The odometry deskewed scans that carry point times (at the last frame): the map and the
   // saved keyframe clouds deskew their raw scans too.
   bool deskewed_scans = false;
+  // Scans without point times that the odometry deskewed got them from the azimuth: the last
+  // such scan's sweep as its order showed it and the times given (the map does the same).
+  std::optional<SweepLayout> azimuth_times;
+  std::size_t redeskewed_frames = 0;  // frames deskewed again at their own velocity
   SettingCheck elevation_check;  // whether the scans proved to need the elevation correction
   // How many frames ran each number of correspondence rounds (index = rounds).
   std::vector<std::size_t> registration_rounds;
