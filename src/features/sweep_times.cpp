@@ -1,5 +1,6 @@
 #include "scfloam/features/sweep_times.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 
@@ -48,7 +49,7 @@ PointAngles angles_of(const std::vector<LidarPoint>& points) {
   for (std::size_t i = 0; i < points.size(); ++i) {
     const LidarPoint& p = points[i];
     const float r = std::sqrt(p.x * p.x + p.y * p.y);
-    if (!(r > 0.05f)) continue;
+    if (!(r > 0.05f) || !std::isfinite(r) || !std::isfinite(p.z)) continue;  // no direction to read
     a.azimuth.push_back(fast_atan2(p.y, p.x));
     a.elevation_tan.push_back(p.z / r);
     a.index.push_back(i);
@@ -94,14 +95,28 @@ SweepLayout layout_of(const PointAngles& a) {
     layout.why = "consecutive points lie far apart in azimuth";
     return layout;
   }
-  layout.turn_found = true;
+  const double turn = layout.clockwise ? -1.0 : 1.0;  // sweep angle = turn * azimuth
+  layout.seam_margin_rad = kSeamMarginRad;
   if (!layout.ring_major) {
-    // Column by column: one revolution, starting at the first point.
+    // Column by column: one revolution, starting with the first column. Its lasers may sit a
+    // few degrees apart (per-laser azimuth offsets, about the column's own azimuth): the seam
+    // is the middle of the first points' spread, less the turn they make (a column's share of
+    // the sweep each), and the margin within which a point may belong to either end grows by
+    // that spread.
     if (revolutions > 1.5) {
       layout.why = "the order runs through " + std::to_string(revolutions) + " revolutions, not one sweep";
       return layout;
     }
-    layout.seam_rad = a.azimuth[0];
+    const std::size_t first = std::min(n, std::max<std::size_t>(16, n / 200));
+    double lowest = 0, highest = 0;
+    for (std::size_t i = 1; i < first; ++i) {
+      const double angle = turn * wrap_pi(double(a.azimuth[i]) - a.azimuth[0]);
+      lowest = std::min(lowest, angle);
+      highest = std::max(highest, angle);
+    }
+    const double advance = kTwoPi * double(first - 1) / double(n);
+    layout.seam_rad = wrap_pi(a.azimuth[0] + turn * 0.5 * (lowest + highest - advance));
+    layout.seam_margin_rad = kSeamMarginRad + (highest - lowest);
   } else {
     // Beam by beam: every beam's revolution starts at the seam, so the passes from one beam to
     // the next gather there (other elevation changes, e.g. over an object's edge with a
@@ -117,6 +132,7 @@ SweepLayout layout_of(const PointAngles& a) {
       const double step = wrap_pi(double(a.azimuth[i]) - a.azimuth[i - 1]);
       if (std::abs(step) > kAdjacentRad) continue;
       const double mid = wrap_pi(a.azimuth[i - 1] + 0.5 * step);
+      if (!std::isfinite(mid)) continue;
       mids.push_back(mid);
       hist[static_cast<int>(wrap_two_pi(mid) / kTwoPi * kBins) % kBins]++;
     }
@@ -127,6 +143,7 @@ SweepLayout layout_of(const PointAngles& a) {
       if (count > best_count) best_count = count, best = b;
     }
     if (best_count < 4 || best_count < 0.25 * double(mids.size())) {
+      layout.seam_unclear = true;
       layout.why = "the passes from one beam to the next do not meet at one azimuth";
       return layout;
     }
@@ -171,31 +188,36 @@ SweepLayout assign_times_from_azimuth(std::vector<LidarPoint>& points, double sw
                                       const SweepLayout* earlier) {
   const PointAngles a = angles_of(points);
   SweepLayout layout = layout_of(a);
-  if (!layout.usable && layout.turn_found && earlier && earlier->usable &&
+  if (!layout.usable && layout.seam_unclear && earlier && earlier->usable &&
       earlier->clockwise == layout.clockwise && earlier->ring_major == layout.ring_major) {
     layout.seam_rad = earlier->seam_rad;
+    layout.seam_margin_rad = earlier->seam_margin_rad;
     layout.seam_from_earlier = layout.usable = true;
+    layout.why.clear();
   }
   if (!layout.usable) return layout;
   layout.sweep_period_s = sweep_period_s;
   layout.stamp_fraction = stamp_fraction;
   const double turn = layout.clockwise ? -1.0 : 1.0;
-  for (auto& p : points) p.time_s = 0;  // points without a horizontal range: the middle
+  // Points with no direction to read (no horizontal range, not finite): the sweep's middle.
+  const auto middle = static_cast<float>((0.5 - stamp_fraction) * sweep_period_s);
+  for (auto& p : points) p.time_s = middle;
   // Walk the order through each revolution: the angle from the seam grows; near the seam
   // (within the seam estimate's margin) a point is the revolution's start until the walk has
   // passed half of it, its end after. Beam by beam, a pass to the next beam that falls back by
   // more than half a turn starts the next revolution.
+  const double margin = layout.seam_margin_rad;
   bool late = false;
   double previous = 0;
   for (std::size_t i = 0; i < a.azimuth.size(); ++i) {
     const double raw = wrap_two_pi(turn * (double(a.azimuth[i]) - layout.seam_rad));
     const bool next_beam = i > 0 && std::abs(a.elevation_tan[i] - a.elevation_tan[i - 1]) >= kSameBeamTan;
     // (Read as a start, so that the seam estimate's error cannot hide the fall.)
-    const double as_start = raw > kTwoPi - kSeamMarginRad ? raw - kTwoPi : raw;
+    const double as_start = raw > kTwoPi - margin ? raw - kTwoPi : raw;
     if (layout.ring_major && next_beam && as_start < previous - M_PI) late = false;
     double angle = raw;
-    if (!late && angle > kTwoPi - kSeamMarginRad) angle -= kTwoPi;
-    if (late && angle < kSeamMarginRad) angle += kTwoPi;
+    if (!late && angle > kTwoPi - margin) angle -= kTwoPi;
+    if (late && angle < margin) angle += kTwoPi;
     if (angle >= M_PI) late = true;
     previous = angle;
     points[a.index[i]].time_s = static_cast<float>((angle / kTwoPi - stamp_fraction) * sweep_period_s);

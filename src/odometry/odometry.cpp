@@ -43,7 +43,27 @@ struct Odometry::Impl {
   // deskew_times_from_azimuth), over a sweep as long as the scans' stamps are apart.
   double sweep_period_s = 0.1;
   std::optional<double> last_stamp_s;
+  std::vector<double> stamp_intervals;  // the last ones between stamps, for the period
   std::optional<SweepLayout> azimuth_layout;  // the last such scan's
+  std::optional<SweepLayout> azimuth_usable;  // the last such scan's that gave times
+
+  // The sweep period for times from the azimuth: the configured one, else the median of the
+  // last intervals between stamps of 0.02-0.25 s (a dropped frame's longer one left out).
+  void update_sweep_period(double stamp_s) {
+    if (last_stamp_s) {
+      const double interval = stamp_s - *last_stamp_s;
+      const bool dropped = !stamp_intervals.empty() && interval > 1.5 * sweep_period_s;
+      if (interval >= 0.02 && interval <= 0.25 && !dropped) {
+        stamp_intervals.push_back(interval);
+        if (stamp_intervals.size() > 21) stamp_intervals.erase(stamp_intervals.begin());
+        std::vector<double> sorted = stamp_intervals;
+        std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+        sweep_period_s = sorted[sorted.size() / 2];
+      }
+    }
+    last_stamp_s = stamp_s;
+    if (config.preprocess.sweep_period_s > 0) sweep_period_s = config.preprocess.sweep_period_s;
+  }
   // Frames 0 and 1 come before there is a velocity to deskew with: their raw points and poses
   // are kept so that frame 2 can put them into the map again, deskewed.
   std::vector<LidarPoint> early_points[2];
@@ -194,6 +214,7 @@ Odometry::Odometry(const OdometryConfig& config) : impl_(std::make_unique<Impl>(
     throw Error("odometry config: outer_iterations and inner_iterations must be >= 1");
   if (p.online_elevation_calibration && !(p.elevation_calibration_gain > 0 && p.elevation_calibration_gain <= 5))
     throw Error("odometry config: elevation_calibration_gain must be in (0, 5]");
+  sweep_stamp_fraction(p.sweep_stamp);  // throws on anything but start, middle, end
   if (p.online_elevation_calibration && p.ground_elevation_calibration)
     throw Error("odometry config: online_elevation_calibration and ground_elevation_calibration both "
                 "estimate the elevation correction: choose one");
@@ -205,7 +226,9 @@ const RingLayoutInfo& Odometry::ring_layout() const { return impl_->extractor.ri
 
 const SettingCheck& Odometry::deskew_check() const { return impl_->deskew_check; }
 bool Odometry::deskews() const { return impl_->config.preprocess.deskew; }
-const std::optional<SweepLayout>& Odometry::azimuth_times() const { return impl_->azimuth_layout; }
+const std::optional<SweepLayout>& Odometry::azimuth_times() const {
+  return impl_->azimuth_usable ? impl_->azimuth_usable : impl_->azimuth_layout;
+}
 const SettingCheck& Odometry::elevation_check() const { return impl_->elevation_check; }
 bool Odometry::may_revise() const { return impl_->trial != Impl::Trial::kNone || impl_->frame0_result; }
 
@@ -213,16 +236,21 @@ OdometryResult Odometry::process(const Scan& scan) {
   Impl& s = *impl_;
   const PreprocessConfig& p = s.config.preprocess;
   if (p.deskew && p.deskew_times_from_azimuth && !scan.has_time) {
-    const double interval = s.last_stamp_s ? scan.timestamp_s - *s.last_stamp_s : 0.0;
-    if (interval >= 0.02 && interval <= 0.25) s.sweep_period_s = interval;
-    s.last_stamp_s = scan.timestamp_s;
-    if (p.sweep_period_s > 0) s.sweep_period_s = p.sweep_period_s;
+    s.update_sweep_period(scan.timestamp_s);
     Scan timed = scan;
-    // The last scan's seam serves where this one's is unclear (drivers cut at a fixed azimuth).
-    const std::optional<SweepLayout> earlier = s.azimuth_layout;
-    s.azimuth_layout = assign_times_from_azimuth(timed.points, s.sweep_period_s, sweep_stamp_fraction(p.sweep_stamp),
-                                                 earlier ? &*earlier : nullptr);
-    if (s.azimuth_layout->usable) {
+    const double stamp_fraction = sweep_stamp_fraction(p.sweep_stamp);
+    // The last usable scan's seam serves where this one's is unclear (drivers cut at a fixed
+    // azimuth).
+    s.azimuth_layout = assign_times_from_azimuth(timed.points, s.sweep_period_s, stamp_fraction,
+                                                 s.azimuth_usable ? &*s.azimuth_usable : nullptr);
+    if (s.azimuth_layout->usable) s.azimuth_usable = s.azimuth_layout;
+    if (s.azimuth_usable) {
+      // A scan whose order gave no times, in a drive whose scans do: all its points at the
+      // sweep's middle (a rigid sweep), so that its solve stays at the middle as its
+      // neighbours' do (solved at the stamp instead, a start- or end-stamped drive's motion
+      // would be measured over half an interval).
+      if (!s.azimuth_layout->usable)
+        for (LidarPoint& pt : timed.points) pt.time_s = static_cast<float>((0.5 - stamp_fraction) * s.sweep_period_s);
       timed.has_time = true;
       return process(timed);
     }
@@ -366,6 +394,12 @@ void Odometry::compare_with_shadow(const Scan& scan, OdometryResult& own, const 
   now.deskew_open = deskew_open;
   now.elevation_open = elevation_open;
   now.first_frame = first_frame;
+  // What the scans' times from the azimuth were read with (the shadow saw timed scans only).
+  now.sweep_period_s = shadow->impl_->sweep_period_s;
+  now.last_stamp_s = shadow->impl_->last_stamp_s;
+  now.stamp_intervals = shadow->impl_->stamp_intervals;
+  now.azimuth_layout = shadow->impl_->azimuth_layout;
+  now.azimuth_usable = shadow->impl_->azimuth_usable;
   now.T_out_own = T_out_other * now.T_out_own;  // the shadow's own frame may have moved (frame 0)
   // `shadow` now holds this odometry's former state, released here.
 }
@@ -378,6 +412,7 @@ OdometryResult Odometry::process_frame(const Scan& scan) {
 
   const std::vector<LidarPoint>* points = &scan.points;
   const bool deskew = c.preprocess.deskew && scan.has_time;
+  double redeskew_features_ms = 0;
   // The solve's time: the stamp, or the middle of a deskewed sweep (sweep_reference_s); the
   // reported pose and features are moved back to the stamp at the end.
   const double reference_s = deskew ? sweep_reference_s(scan.points) : 0.0;
@@ -488,7 +523,9 @@ OdometryResult Odometry::process_frame(const Scan& scan) {
         s.extractor.extract(s.deskewed, scan.has_ring && c.rings.use_ring_field, s.raw_edges, nullptr);
         s.edge_filter.filter(s.raw_edges, c.features.edge_leaf_m, result.edges);
         s.plane_filter.filter_runs(s.extractor.plane_runs(), result.planes);
-        result.features_ms += again.elapsed_ms();
+        const double again_ms = again.elapsed_ms();
+        result.features_ms += again_ms;
+        redeskew_features_ms = again_ms;  // counted in features, not in registration
         reg = registration.align(result.edges, result.planes, s.map, reg.T_world_lidar, s.rounds);
         result.redeskewed = true;
       }
@@ -564,7 +601,7 @@ OdometryResult Odometry::process_frame(const Scan& scan) {
   }
   if (s.frames == 0 && reference_s != 0) s.frame0_result = result;
   ++s.frames;
-  result.registration_ms = watch.elapsed_ms();
+  result.registration_ms = watch.elapsed_ms() - redeskew_features_ms;
   return result;
 }
 

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "scfloam/error.hpp"
@@ -24,7 +25,7 @@ struct Sweep {
 // A VLP-16-like sweep starting at azimuth `seam` (radians), rows or columns first. Returns are
 // dropped at random (10 %) and, for the top four beams, over the first fifth of the sweep
 // (open sky behind the car), so that no beam's first return need sit at the seam.
-Sweep make_sweep(double seam, bool clockwise, bool ring_major, unsigned seed) {
+Sweep make_sweep(double seam, bool clockwise, bool ring_major, unsigned seed, double laser_offset_deg = 0) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> range(4.0, 60.0), unit(0.0, 1.0);
   std::vector<std::vector<LidarPoint>> grid(kBeams, std::vector<LidarPoint>(kColumns));
@@ -32,9 +33,12 @@ Sweep make_sweep(double seam, bool clockwise, bool ring_major, unsigned seed) {
   std::vector<std::vector<bool>> kept(kBeams, std::vector<bool>(kColumns));
   for (int c = 0; c < kColumns; ++c) {
     const double frac = (c + 0.5) / kColumns;
-    const double az = seam + (clockwise ? -1 : 1) * 2 * M_PI * frac;
+    const double az_column = seam + (clockwise ? -1 : 1) * 2 * M_PI * frac;
     for (int b = 0; b < kBeams; ++b) {
-      const double el = (-15.0 + 2.0 * b) * M_PI / 180, r = range(rng);
+      // Per-laser azimuth offsets (alternating, as in a column of staggered lasers): each beam
+      // points off its column by up to laser_offset_deg, firing at the column's time.
+      const double off = laser_offset_deg * M_PI / 180 * ((b % 4) - 1.5) / 1.5;
+      const double el = (-15.0 + 2.0 * b) * M_PI / 180, r = range(rng), az = az_column + off;
       LidarPoint& p = grid[b][c];
       p.x = static_cast<float>(r * std::cos(el) * std::cos(az));
       p.y = static_cast<float>(r * std::cos(el) * std::sin(az));
@@ -94,6 +98,36 @@ TEST(SweepTimes, EveryOrderAndTurnGivesEachPointItsTime) {
       }
 }
 
+// Points with no direction (on the axis, not finite) neither break the layout nor get a time
+// from it: they are put at the sweep's middle.
+TEST(SweepTimes, PointsWithoutADirectionGetTheSweepsMiddle) {
+  Sweep s = make_sweep(0.7, false, false, 9);
+  const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
+  for (std::size_t i : {std::size_t{5}, std::size_t{5000}, std::size_t{9000}}) s.points[i] = LidarPoint{};
+  s.points[6].x = inf;
+  s.points[7].y = nan;
+  s.points[8].z = -inf;
+  const SweepLayout layout = assign_times_from_azimuth(s.points, kPeriod, sweep_stamp_fraction("start"));
+  ASSERT_TRUE(layout.usable) << layout.why;
+  for (std::size_t i : {5, 6, 7, 8, 5000, 9000}) EXPECT_FLOAT_EQ(s.points[i].time_s, 0.5 * kPeriod) << i;
+  for (std::size_t i = 10; i < s.points.size(); i += 101)
+    if (i != 5000 && i != 9000) EXPECT_NEAR(s.points[i].time_s, s.times[i] + 0.5 * kPeriod, 2e-4) << i;
+}
+
+// Column by column, a column's lasers may point a few degrees apart (per-laser azimuth
+// offsets): the first column's points must still count as the sweep's start and the last
+// column's as its end. A point's time then errs by its laser's offset (up to 8 deg here: 2 ms).
+TEST(SweepTimes, LasersOffTheirColumnKeepTheirEndOfTheSweep) {
+  for (const double offset : {3.4, 8.0})
+    for (const bool clockwise : {true, false}) {
+      SCOPED_TRACE(::testing::Message() << offset << " deg, " << (clockwise ? "clockwise" : "counterclockwise"));
+      Sweep s = make_sweep(-0.4, clockwise, false, 13, offset);
+      const SweepLayout layout = assign_times_from_azimuth(s.points, kPeriod);
+      ASSERT_TRUE(layout.usable) << layout.why;
+      EXPECT_LT(max_time_error(s), (offset / 360 + 0.002) * kPeriod);
+    }
+}
+
 TEST(SweepTimes, TheStampsPlaceInTheSweepShiftsEveryTime) {
   Sweep start = make_sweep(0.3, true, true, 3), end = start;
   ASSERT_TRUE(assign_times_from_azimuth(start.points, kPeriod, sweep_stamp_fraction("start")).usable);
@@ -131,6 +165,13 @@ TEST(SweepTimes, AnUnclearSeamIsTakenFromAnEarlierScan) {
   ASSERT_TRUE(layout.usable);
   EXPECT_TRUE(layout.seam_from_earlier);
   EXPECT_LT(max_time_error(kept), 2e-4);
+  // Nor is it taken for an order that is no single sweep: column by column twice round.
+  Sweep twice = make_sweep(seam, true, false, 14);
+  const std::size_t half = twice.points.size();
+  for (std::size_t i = 0; i < half; ++i) twice.points.push_back(twice.points[i]);
+  const SweepLayout twice_layout = assign_times_from_azimuth(twice.points, kPeriod, 0.5, &earlier);
+  EXPECT_FALSE(twice_layout.usable);
+  EXPECT_FALSE(twice_layout.seam_from_earlier);
   // An earlier layout of the other turn is not taken.
   SweepLayout other = earlier;
   other.clockwise = false;

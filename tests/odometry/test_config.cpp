@@ -73,8 +73,17 @@ TEST(Config, UnknownKeysAndWrongTypesAreErrorsNamingFileAndKey) {
   expect_error_naming(dir / "missing.yaml", "cannot open");
   write(dir / "stamp.yaml", "odometry:\n  preprocess:\n    sweep_stamp: sideways\n");
   expect_error_naming(dir / "stamp.yaml", "odometry.preprocess.sweep_stamp");
-  write(dir / "period.yaml", "odometry:\n  preprocess:\n    sweep_period_s: 2.5\n");
-  expect_error_naming(dir / "period.yaml", "odometry.preprocess.sweep_period_s");
+  for (const char* period : {"2.5", "0.001", "-0.1"}) {
+    write(dir / "period.yaml", std::string("odometry:\n  preprocess:\n    sweep_period_s: ") + period + "\n");
+    expect_error_naming(dir / "period.yaml", "odometry.preprocess.sweep_period_s");
+  }
+  write(dir / "redeskew.yaml", "odometry:\n  preprocess:\n    redeskew_min_rotation_deg: -1\n");
+  expect_error_naming(dir / "redeskew.yaml", "odometry.preprocess.redeskew_min_rotation_deg");
+  write(dir / "redeskew_m.yaml", "odometry:\n  preprocess:\n    redeskew_min_translation_m: -0.5\n");
+  expect_error_naming(dir / "redeskew_m.yaml", "odometry.preprocess.redeskew_min_translation_m");
+  OdometryConfig direct;  // the same check for a config built in code
+  direct.preprocess.sweep_stamp = "sideways";
+  EXPECT_THROW(Odometry{direct}, Error);
   write(dir / "sweep.yaml",
         "odometry:\n  preprocess:\n    sweep_stamp: end\n    sweep_period_s: 0.05\n    redeskew: false\n");
   const SlamConfig sweep = load_config(dir / "sweep.yaml");

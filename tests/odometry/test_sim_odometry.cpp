@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <random>
 #include <vector>
 
 #include "odometry/rendered_drive.hpp"
@@ -275,20 +276,48 @@ TEST(SimOdometry, ScansWithoutTimesAreDeskewedFromTheirAzimuth) {
     scan.has_time = false;
     for (LidarPoint& p : scan.points) p.time_s = 0;
   }
+  // The times themselves: the simulator's, to a fraction of a degree of the sweep (a column is
+  // 0.2 deg, 56 us).
+  for (const std::size_t k : {0, 40, 99}) {
+    std::vector<LidarPoint> points = untimed.scans[k].points;
+    ASSERT_TRUE(assign_times_from_azimuth(points, timed.sweep_period_s).usable) << k;
+    double worst = 0;
+    for (std::size_t i = 0; i < points.size(); ++i)
+      worst = std::max(worst, double(std::abs(points[i].time_s - timed.scans[k].points[i].time_s)));
+    EXPECT_LT(worst, 3e-4) << k;
+  }
   const Drift with_times = run_sim(timed, forced, true);
   const Drift from_azimuth = run_sim(untimed, forced, true);
-  const Drift distorted = run_sim(untimed, no_azimuth, true);
-  EXPECT_LT(from_azimuth.end_error_m, 1.5 * with_times.end_error_m + 0.02);
-  EXPECT_LT(from_azimuth.max_frame_error_m, 1.5 * with_times.max_frame_error_m + 0.005);
+  const Drift distorted = run_sim(untimed, no_azimuth, true);  // printed: what it was before
   // Measured: 0.305 m at the end and 12 mm per frame at most (the driver's times: 0.299 m,
   // 12 mm); left distorted 0.445 m and 23 mm.
-  EXPECT_GT(distorted.max_frame_error_m, 1.5 * from_azimuth.max_frame_error_m);
-  EXPECT_GT(distorted.end_error_m, 1.3 * from_azimuth.end_error_m);
+  EXPECT_LT(from_azimuth.end_error_m, 1.5 * with_times.end_error_m + 0.02);
+  EXPECT_LT(from_azimuth.max_frame_error_m, 1.5 * with_times.max_frame_error_m + 0.005);
+  (void)distorted;
+
+  // A scan out of firing order between two sweeps does not lose the seam: the next scan, whose
+  // own seam is unclear (only the two lowest beams return near it), takes the first one's.
   Odometry odometry(forced);
   odometry.process(untimed.scans[0]);
   ASSERT_TRUE(odometry.azimuth_times().has_value());
   EXPECT_TRUE(odometry.azimuth_times()->usable);
-  EXPECT_TRUE(odometry.azimuth_times()->clockwise);  // as the simulator and Velodyne spin
+  EXPECT_TRUE(odometry.azimuth_times()->clockwise);  // as the simulator turns
+  Scan shuffled = untimed.scans[1];
+  std::shuffle(shuffled.points.begin(), shuffled.points.end(), std::mt19937(2));
+  EXPECT_FALSE(sweep_layout(shuffled.points).usable);
+  odometry.process(shuffled);
+  Scan unclear = untimed.scans[2];
+  const double seam = odometry.azimuth_times()->seam_rad;
+  unclear.points.erase(std::remove_if(unclear.points.begin(), unclear.points.end(),
+                                      [&](const LidarPoint& p) {
+                                        const double off = std::remainder(std::atan2(p.y, p.x) - seam, 2 * M_PI);
+                                        return std::abs(off) < 10 * M_PI / 180 && p.z > -0.2 * std::hypot(p.x, p.y);
+                                      }),
+                       unclear.points.end());
+  EXPECT_TRUE(sweep_layout(unclear.points).seam_unclear);
+  odometry.process(unclear);
+  EXPECT_TRUE(odometry.azimuth_times()->usable);
+  EXPECT_TRUE(odometry.azimuth_times()->seam_from_earlier);
   // With the preset's check, the untimed scans prove distorted as the timed ones do.
   SettingCheck check;
   run_sim(untimed, preset, true, nullptr, &check);
