@@ -236,6 +236,7 @@ OdometryResult Odometry::process(const Scan& scan) {
   Impl& s = *impl_;
   const PreprocessConfig& p = s.config.preprocess;
   if (p.deskew && p.deskew_times_from_azimuth && !scan.has_time) {
+    Stopwatch timing;  // the times are part of the frame's feature step
     s.update_sweep_period(scan.timestamp_s);
     Scan timed = scan;
     const double stamp_fraction = sweep_stamp_fraction(p.sweep_stamp);
@@ -252,7 +253,10 @@ OdometryResult Odometry::process(const Scan& scan) {
       if (!s.azimuth_layout->usable)
         for (LidarPoint& pt : timed.points) pt.time_s = static_cast<float>((0.5 - stamp_fraction) * s.sweep_period_s);
       timed.has_time = true;
-      return process(timed);
+      const double times_ms = timing.elapsed_ms();
+      OdometryResult result = process(timed);
+      result.features_ms += times_ms;
+      return result;
     }
   }
   if (s.frames == 0) {
