@@ -12,6 +12,7 @@
 #endif
 
 #include "scfloam/error.hpp"
+#include "scfloam/features/fast_atan.hpp"
 #include "scfloam/xyz4.hpp"
 
 namespace scfloam {
@@ -21,13 +22,7 @@ namespace {
 constexpr std::size_t kMaxBeams = 128;  // the largest model (OS1-128)
 constexpr int kMaxRingField = 1024;     // rings a ring field may number (larger values are dropped)
 
-// atan for |x| <= 1, |error| <= 1e-5 rad (Abramowitz & Stegun 4.4.47): 5x cheaper than atan2,
-// and 6e-4 deg is far below the 1/3 deg beam spacing.
-inline float fast_atan_unit(float x) {
-  const float x2 = x * x;
-  return x * (0.9998660f + x2 * (-0.3302995f + x2 * (0.1801410f + x2 * (-0.0851330f + x2 * 0.0208351f))));
-}
-
+// fast_atan_unit (features/fast_atan.hpp): 6e-4 deg is far below the 1/3 deg beam spacing.
 inline float elevation_deg(float z, float horizontal_range) {
   constexpr float kDeg = 180.0f / static_cast<float>(M_PI);
   const float az = std::abs(z);

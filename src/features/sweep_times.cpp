@@ -159,20 +159,6 @@ SweepLayout layout_of(const PointAngles& a) {
 
 }  // namespace
 
-float fast_atan2(float y, float x) {
-  // atan on [0, 1] by an odd minimax polynomial (error < 1e-5 rad), then the octant.
-  const float ax = std::abs(x), ay = std::abs(y);
-  const float big = std::max(ax, ay);
-  if (big == 0.0f) return 0.0f;
-  const float t = std::min(ax, ay) / big;
-  const float t2 = t * t;
-  float r = t * (0.99997726f +
-                 t2 * (-0.33262347f + t2 * (0.19354346f + t2 * (-0.11643287f + t2 * (0.05265332f + t2 * -0.01172120f)))));
-  if (ay > ax) r = static_cast<float>(M_PI_2) - r;
-  if (x < 0) r = static_cast<float>(M_PI) - r;
-  return y < 0 ? -r : r;
-}
-
 SweepLayout sweep_layout(const std::vector<LidarPoint>& points) {
   return layout_of(angles_of(points));
 }

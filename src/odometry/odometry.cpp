@@ -40,29 +40,40 @@ struct Odometry::Impl {
 
   std::vector<LidarPoint> deskewed;
   // Scans without point times, deskewed: times from the azimuth (PreprocessConfig::
-  // deskew_times_from_azimuth), over a sweep as long as the scans' stamps are apart.
-  double sweep_period_s = 0.1;
-  std::optional<double> last_stamp_s;
-  std::vector<double> stamp_intervals;  // the last ones between stamps, for the period
-  std::optional<SweepLayout> azimuth_layout;  // the last such scan's
-  std::optional<SweepLayout> azimuth_usable;  // the last such scan's that gave times
+  // deskew_times_from_azimuth), over a sweep as long as the scans' stamps are apart. What the
+  // input's sweeps showed, not a setting: a switching check hands it to the shadow whole.
+  struct AzimuthTimes {
+    double sweep_period_s = 0.1;
+    std::optional<double> last_stamp_s;
+    std::vector<double> stamp_intervals;  // the last ones between stamps, for the period
+    std::optional<SweepLayout> layout;    // the last such scan's
+    std::optional<SweepLayout> usable;    // the last such scan's that gave times
 
-  // The sweep period for times from the azimuth: the configured one, else the median of the
-  // last intervals between stamps of 0.02-0.25 s (a dropped frame's longer one left out).
-  void update_sweep_period(double stamp_s) {
-    if (last_stamp_s) {
-      const double interval = stamp_s - *last_stamp_s;
-      const bool dropped = !stamp_intervals.empty() && interval > 1.5 * sweep_period_s;
-      if (interval >= 0.02 && interval <= 0.25 && !dropped) {
-        stamp_intervals.push_back(interval);
-        if (stamp_intervals.size() > 21) stamp_intervals.erase(stamp_intervals.begin());
-        std::vector<double> sorted = stamp_intervals;
-        std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-        sweep_period_s = sorted[sorted.size() / 2];
+    // The configured period, else the median of the last intervals between stamps of
+    // 0.02-0.25 s (a dropped frame's longer one left out).
+    void update_period(double stamp_s, double configured_s) {
+      if (last_stamp_s) {
+        const double interval = stamp_s - *last_stamp_s;
+        const bool dropped = !stamp_intervals.empty() && interval > 1.5 * sweep_period_s;
+        if (interval >= 0.02 && interval <= 0.25 && !dropped) {
+          stamp_intervals.push_back(interval);
+          if (stamp_intervals.size() > 21) stamp_intervals.erase(stamp_intervals.begin());
+          std::vector<double> sorted = stamp_intervals;
+          std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+          sweep_period_s = sorted[sorted.size() / 2];
+        }
       }
+      last_stamp_s = stamp_s;
+      if (configured_s > 0) sweep_period_s = configured_s;
     }
-    last_stamp_s = stamp_s;
-    if (config.preprocess.sweep_period_s > 0) sweep_period_s = config.preprocess.sweep_period_s;
+  } azimuth;
+
+  // The frame's features from these (deskewed) points: edges and the plane runs, downsampled.
+  void extract_features(const std::vector<LidarPoint>& pts, bool use_rings, bool full_planes,
+                        OdometryResult& result) {
+    extractor.extract(pts, use_rings, raw_edges, full_planes ? &raw_planes : nullptr);
+    edge_filter.filter(raw_edges, config.features.edge_leaf_m, result.edges);
+    plane_filter.filter_runs(extractor.plane_runs(), result.planes);
   }
   // Frames 0 and 1 come before there is a velocity to deskew with: their raw points and poses
   // are kept so that frame 2 can put them into the map again, deskewed.
@@ -227,7 +238,7 @@ const RingLayoutInfo& Odometry::ring_layout() const { return impl_->extractor.ri
 const SettingCheck& Odometry::deskew_check() const { return impl_->deskew_check; }
 bool Odometry::deskews() const { return impl_->config.preprocess.deskew; }
 const std::optional<SweepLayout>& Odometry::azimuth_times() const {
-  return impl_->azimuth_usable ? impl_->azimuth_usable : impl_->azimuth_layout;
+  return impl_->azimuth.usable ? impl_->azimuth.usable : impl_->azimuth.layout;
 }
 const SettingCheck& Odometry::elevation_check() const { return impl_->elevation_check; }
 bool Odometry::may_revise() const { return impl_->trial != Impl::Trial::kNone || impl_->frame0_result; }
@@ -237,21 +248,22 @@ OdometryResult Odometry::process(const Scan& scan) {
   const PreprocessConfig& p = s.config.preprocess;
   if (p.deskew && p.deskew_times_from_azimuth && !scan.has_time) {
     Stopwatch timing;  // the times are part of the frame's feature step
-    s.update_sweep_period(scan.timestamp_s);
+    Impl::AzimuthTimes& az = s.azimuth;
+    az.update_period(scan.timestamp_s, p.sweep_period_s);
     Scan timed = scan;
     const double stamp_fraction = sweep_stamp_fraction(p.sweep_stamp);
     // The last usable scan's seam serves where this one's is unclear (drivers cut at a fixed
     // azimuth).
-    s.azimuth_layout = assign_times_from_azimuth(timed.points, s.sweep_period_s, stamp_fraction,
-                                                 s.azimuth_usable ? &*s.azimuth_usable : nullptr);
-    if (s.azimuth_layout->usable) s.azimuth_usable = s.azimuth_layout;
-    if (s.azimuth_usable) {
+    az.layout = assign_times_from_azimuth(timed.points, az.sweep_period_s, stamp_fraction,
+                                          az.usable ? &*az.usable : nullptr);
+    if (az.layout->usable) az.usable = az.layout;
+    if (az.usable) {
       // A scan whose order gave no times, in a drive whose scans do: all its points at the
       // sweep's middle (a rigid sweep), so that its solve stays at the middle as its
       // neighbours' do (solved at the stamp instead, a start- or end-stamped drive's motion
       // would be measured over half an interval).
-      if (!s.azimuth_layout->usable)
-        for (LidarPoint& pt : timed.points) pt.time_s = static_cast<float>((0.5 - stamp_fraction) * s.sweep_period_s);
+      if (!az.layout->usable)
+        for (LidarPoint& pt : timed.points) pt.time_s = static_cast<float>((0.5 - stamp_fraction) * az.sweep_period_s);
       timed.has_time = true;
       const double times_ms = timing.elapsed_ms();
       OdometryResult result = process(timed);
@@ -399,11 +411,7 @@ void Odometry::compare_with_shadow(const Scan& scan, OdometryResult& own, const 
   now.elevation_open = elevation_open;
   now.first_frame = first_frame;
   // What the scans' times from the azimuth were read with (the shadow saw timed scans only).
-  now.sweep_period_s = shadow->impl_->sweep_period_s;
-  now.last_stamp_s = shadow->impl_->last_stamp_s;
-  now.stamp_intervals = shadow->impl_->stamp_intervals;
-  now.azimuth_layout = shadow->impl_->azimuth_layout;
-  now.azimuth_usable = shadow->impl_->azimuth_usable;
+  now.azimuth = std::move(shadow->impl_->azimuth);
   now.T_out_own = T_out_other * now.T_out_own;  // the shadow's own frame may have moved (frame 0)
   // `shadow` now holds this odometry's former state, released here.
 }
@@ -421,13 +429,16 @@ OdometryResult Odometry::process_frame(const Scan& scan) {
   // reported pose and features are moved back to the stamp at the end.
   const double reference_s = deskew ? sweep_reference_s(scan.points) : 0.0;
   const double time_s = scan.timestamp_s + reference_s;
-  if (deskew && s.frames >= 2 && s.delta_dt_s > 0) {
-    // Constant velocity from the last two poses, in the sensor's body frame.
-    const Eigen::Vector3d omega = so3_log(s.T_delta.linear()) / s.delta_dt_s;
-    const Eigen::Vector3d velocity = s.T_delta.translation() / s.delta_dt_s;
-    if (s.frames == 2) redeskew_first_frames(omega, velocity);
+  // Constant velocity from the last two poses, in the sensor's body frame: what the sweep is
+  // deskewed with (and what a second deskew compares the frame's own solve against).
+  const bool deskewed_at_last_velocity = deskew && s.frames >= 2 && s.delta_dt_s > 0;
+  Eigen::Vector3d omega_used = Eigen::Vector3d::Zero(), velocity_used = Eigen::Vector3d::Zero();
+  if (deskewed_at_last_velocity) {
+    omega_used = so3_log(s.T_delta.linear()) / s.delta_dt_s;
+    velocity_used = s.T_delta.translation() / s.delta_dt_s;
+    if (s.frames == 2) redeskew_first_frames(omega_used, velocity_used);
     s.deskewed = scan.points;
-    deskew_constant_velocity(s.deskewed, omega, velocity, reference_s);
+    deskew_constant_velocity(s.deskewed, omega_used, velocity_used, reference_s);
     points = &s.deskewed;
   }
   if (deskew && s.frames < 2) {
@@ -440,10 +451,8 @@ OdometryResult Odometry::process_frame(const Scan& scan) {
                                                          : c.preprocess.elevation_correction_deg;
   // Only the first frame needs its planes at full density (below); the others' planes are
   // downsampled from the runs the extractor summed per ring.
-  s.extractor.extract(*points, scan.has_ring && c.rings.use_ring_field, s.raw_edges,
-                      s.frames == 0 ? &s.raw_planes : nullptr);
-  s.edge_filter.filter(s.raw_edges, c.features.edge_leaf_m, result.edges);
-  s.plane_filter.filter_runs(s.extractor.plane_runs(), result.planes);
+  const bool use_rings = scan.has_ring && c.rings.use_ring_field;
+  s.extract_features(*points, use_rings, s.frames == 0, result);
   result.features_ms = watch.elapsed_ms();
   watch.restart();
 
@@ -511,12 +520,10 @@ OdometryResult Odometry::process_frame(const Scan& scan) {
     // the solve fails (docs/odometry.md, "Session 38"). Deskewed again at the velocity just
     // solved and solved once more from there.
     const double interval_s = time_s - s.last_time_s;
-    if (deskew && s.frames >= 2 && s.delta_dt_s > 0 && interval_s > 0 && !gap && c.preprocess.redeskew) {
+    if (deskewed_at_last_velocity && interval_s > 0 && !gap && c.preprocess.redeskew) {
       const Eigen::Isometry3d solved = s.T_last.inverse() * reg.T_world_lidar;
       const Eigen::Vector3d omega = so3_log(solved.linear()) / interval_s;
       const Eigen::Vector3d velocity = solved.translation() / interval_s;
-      const Eigen::Vector3d omega_used = so3_log(s.T_delta.linear()) / s.delta_dt_s;
-      const Eigen::Vector3d velocity_used = s.T_delta.translation() / s.delta_dt_s;
       // What the difference moves a point at the sweep's ends (a sweep lasts about an interval).
       const double half_sweep_s = 0.5 * interval_s;
       if ((omega - omega_used).norm() * half_sweep_s > c.preprocess.redeskew_min_rotation_deg * M_PI / 180 ||
@@ -524,9 +531,7 @@ OdometryResult Odometry::process_frame(const Scan& scan) {
         Stopwatch again;
         s.deskewed = scan.points;
         deskew_constant_velocity(s.deskewed, omega, velocity, reference_s);
-        s.extractor.extract(s.deskewed, scan.has_ring && c.rings.use_ring_field, s.raw_edges, nullptr);
-        s.edge_filter.filter(s.raw_edges, c.features.edge_leaf_m, result.edges);
-        s.plane_filter.filter_runs(s.extractor.plane_runs(), result.planes);
+        s.extract_features(s.deskewed, use_rings, false, result);
         const double again_ms = again.elapsed_ms();
         result.features_ms += again_ms;
         redeskew_features_ms = again_ms;  // counted in features, not in registration

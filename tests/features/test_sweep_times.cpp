@@ -110,8 +110,11 @@ TEST(SweepTimes, PointsWithoutADirectionGetTheSweepsMiddle) {
   const SweepLayout layout = assign_times_from_azimuth(s.points, kPeriod, sweep_stamp_fraction("start"));
   ASSERT_TRUE(layout.usable) << layout.why;
   for (std::size_t i : {5, 6, 7, 8, 5000, 9000}) EXPECT_FLOAT_EQ(s.points[i].time_s, 0.5 * kPeriod) << i;
-  for (std::size_t i = 10; i < s.points.size(); i += 101)
-    if (i != 5000 && i != 9000) EXPECT_NEAR(s.points[i].time_s, s.times[i] + 0.5 * kPeriod, 2e-4) << i;
+  for (std::size_t i = 10; i < s.points.size(); i += 101) {
+    if (i != 5000 && i != 9000) {
+      EXPECT_NEAR(s.points[i].time_s, s.times[i] + 0.5 * kPeriod, 2e-4) << i;
+    }
+  }
 }
 
 // Column by column, a column's lasers may point a few degrees apart (per-laser azimuth
