@@ -7,7 +7,7 @@ an aggressive car. Smooth at 100 Hz (speed and turn rates through smoothsteps), 
   scfloam simulate --out SEQ --replay OUT.txt --sensor os1-64 --motion-distortion [--scan-format pcd]
 
 The replay takes x, y and the rotation from the file (z follows the simulated terrain).
-Needs numpy and scipy (Debian: python3-numpy python3-scipy).
+Needs numpy and scipy (Debian: python3-numpy python3-scipy; scripts/install-deps.sh installs both).
 """
 import sys
 

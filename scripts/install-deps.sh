@@ -10,7 +10,7 @@ packages=(
   librosbag-dev libsensor-msgs-dev  # ROS 1 bags (reader; sensor_msgs only for the writer in tests)
   libopen3d-dev
   clang libclang-rt-14-dev
-  python3 python3-matplotlib python3-numpy
+  python3 python3-matplotlib python3-numpy python3-scipy  # scipy: bench/unusual_motions.py, bench/loop_edges_vs_truth.py
 )
 missing=()
 for p in "${packages[@]}"; do
