@@ -92,6 +92,12 @@ scfloam::cli::RegisterCommand reg("simulate", [](CLI::App& app) {
   sub->add_option("--beam-range-bias", args->config.beam_range_bias_m,
                   "Per-beam range bias, 1 sigma in metres (default: the sensor's, 0.008)")
       ->check(CLI::Range(0.0, 1.0));
+  sub->add_option("--mount-pitch", args->config.mount_pitch_deg,
+                  "The sensor's pitch on the vehicle in degrees, positive = tilted down ahead (default 0)")
+      ->check(CLI::Range(-90.0, 90.0));
+  sub->add_option("--mount-roll", args->config.mount_roll_deg,
+                  "The sensor's roll on the vehicle in degrees, about the forward axis (default 0)")
+      ->check(CLI::Range(-90.0, 90.0));
   sub->add_flag("--no-traffic", args->no_traffic, "A static world: no moving cars or pedestrians");
   sub->add_option("--oncoming-per-min", args->config.traffic.oncoming_per_minute, "Oncoming cars passing per minute")
       ->capture_default_str();

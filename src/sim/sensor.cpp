@@ -16,6 +16,13 @@ std::vector<double> linear_beams(double top_deg, double bottom_deg, int count) {
 }
 }  // namespace
 
+Eigen::Matrix3d SensorModel::mount_rotation() const {
+  const double d = M_PI / 180.0;
+  return (Eigen::AngleAxisd(mount_pitch_deg * d, Eigen::Vector3d::UnitY()) *
+          Eigen::AngleAxisd(mount_roll_deg * d, Eigen::Vector3d::UnitX()))
+      .toRotationMatrix();
+}
+
 std::vector<std::string> sensor_preset_names() {
   return {"hdl64", "vlp16", "hdl32", "os1-64", "os1-128", "vlp32c"};
 }

@@ -1,6 +1,7 @@
 // Writing a simulated sequence in the KITTI odometry layout.
 #include "scfloam/sim/simulate.hpp"
 
+#include <cmath>
 #include <cstdio>
 #include <sstream>
 
@@ -25,6 +26,11 @@ SensorModel sensor_for(const SimConfig& config) {
   if (config.beam_elevation_error_deg >= 0) s.beam_elevation_error_deg = config.beam_elevation_error_deg;
   if (config.beam_azimuth_error_deg >= 0) s.beam_azimuth_error_deg = config.beam_azimuth_error_deg;
   if (config.beam_range_bias_m >= 0) s.beam_range_bias_m = config.beam_range_bias_m;
+  if (!std::isfinite(config.mount_roll_deg) || !std::isfinite(config.mount_pitch_deg) ||
+      std::abs(config.mount_roll_deg) > 90 || std::abs(config.mount_pitch_deg) > 90)
+    throw Error("simulate: the mount's roll and pitch must be within -90..90 degrees");
+  s.mount_roll_deg = config.mount_roll_deg;
+  s.mount_pitch_deg = config.mount_pitch_deg;
   return s;
 }
 
@@ -61,11 +67,12 @@ Scan render_frame(const Scenario& sc, const SensorModel& sensor, const BeamCalib
                   const SimConfig& config, std::size_t k, const Traffic* traffic) {
   const double stamp = sc.frame_time(k);
   const double middle = stamp + sweep_middle_after_stamp_s(config.sweep_stamp, sensor);
+  const auto at = [&](double t) { return sensor_pose_at(sc, sensor, t); };
   SweepPoses poses;
-  poses.T_world_lidar = sc.trajectory.at(config.motion_distortion ? middle : stamp);
+  poses.T_world_lidar = at(config.motion_distortion ? middle : stamp);
   poses.motion_distortion = config.motion_distortion;
-  poses.T_world_lidar_start = sc.trajectory.at(middle - 0.5 * sensor.sweep_period_s);
-  poses.T_world_lidar_end = sc.trajectory.at(middle + 0.5 * sensor.sweep_period_s);
+  poses.T_world_lidar_start = at(middle - 0.5 * sensor.sweep_period_s);
+  poses.T_world_lidar_end = at(middle + 0.5 * sensor.sweep_period_s);
   Scan scan = render_scan(sc.world, sensor, calib, poses, config.seed, k, traffic, middle);
   // render_scan counts point times from the sweep's middle.
   if (middle != stamp) {
@@ -76,10 +83,16 @@ Scan render_frame(const Scenario& sc, const SensorModel& sensor, const BeamCalib
   return scan;
 }
 
-PoseList relative_lidar_poses(const Scenario& sc) {
+Pose sensor_pose_at(const Scenario& sc, const SensorModel& sensor, double t) {
+  Pose T = sc.trajectory.at(t);
+  T.linear() = T.linear() * sensor.mount_rotation();
+  return T;
+}
+
+PoseList relative_lidar_poses(const Scenario& sc, const SensorModel& sensor) {
   PoseList out;
-  const Pose T0_inv = sc.frame_pose(0).inverse();
-  for (std::size_t k = 0; k < sc.frames; ++k) out.push_back(T0_inv * sc.frame_pose(k));
+  const Pose T0_inv = sensor_pose_at(sc, sensor, sc.frame_time(0)).inverse();
+  for (std::size_t k = 0; k < sc.frames; ++k) out.push_back(T0_inv * sensor_pose_at(sc, sensor, sc.frame_time(k)));
   return out;
 }
 
@@ -134,7 +147,7 @@ void simulate_sequence(const SimConfig& config, const fs::path& out_dir, bool pr
       out << buf;
     }
   });
-  write_kitti_poses(out_dir / "poses.txt", lidar_to_camera_poses(relative_lidar_poses(sc), Tr));
+  write_kitti_poses(out_dir / "poses.txt", lidar_to_camera_poses(relative_lidar_poses(sc, sensor), Tr));
   write_file_atomic(out_dir / "sim.yaml", [&](std::ostream& out) {
     out << "# scfloam simulate: the parameters that made this sequence\n";
     out << "seed: " << config.seed << "\n";
@@ -152,6 +165,8 @@ void simulate_sequence(const SimConfig& config, const fs::path& out_dir, bool pr
     out << "max_range_m: " << sensor.max_range_m << "\n";
     out << "min_range_m: " << sensor.min_range_m << "\n";
     out << "mount_height_m: " << sensor.mount_height_m << "\n";
+    out << "mount_roll_deg: " << sensor.mount_roll_deg << "\n";
+    out << "mount_pitch_deg: " << sensor.mount_pitch_deg << "\n";
     out << "range_noise_m: " << sensor.range_noise_m << "\n";
     out << "dropout_prob: " << sensor.dropout_prob << "\n";
     out << "elevation_bias_deg: " << sensor.elevation_bias_deg << "\n";

@@ -322,5 +322,61 @@ TEST(SimulateSweepStamp, PointTimesCountFromTheStampWhereverItIs) {
   EXPECT_THROW(render_frame(sc, s, calib, cfg, 1), Error);
 }
 
+// `--mount-pitch` / `--mount-roll`: a sensor tilted on the vehicle. Its points, put in the
+// world with the pose the simulator reports, lie on the world's surfaces; in its own frame the
+// ground is tilted by the mount; and poses.txt is the tilted sensor's motion (the vehicle's
+// turned by the mount), not the vehicle's.
+TEST(SimulateMount, ATiltedSensorSeesTheWorldFromItsTiltedFrame) {
+  test::WallAhead wall = test::wall_ahead(3);
+  wall.sensor.elevation_bias_deg = 0;  // no cone: the ground is exactly z = 0
+  wall.sensor.mount_pitch_deg = 12;
+  wall.sensor.mount_roll_deg = -5;
+  // A turning vehicle: yaw grows along the trajectory, so that the mount does not commute.
+  for (std::size_t i = 0; i < wall.scenario.trajectory.T_world_lidar.size(); ++i)
+    wall.scenario.trajectory.T_world_lidar[i].linear() =
+        Eigen::AngleAxisd(0.02 * static_cast<double>(i), Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const Scenario& sc = wall.scenario;
+  SimConfig cfg;
+  const Scan scan = render_frame(sc, wall.sensor, wall.calibration, cfg, 1);
+  const Pose T = sensor_pose_at(sc, wall.sensor, sc.frame_time(1));
+  Eigen::Matrix3d ground_cov = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d ground_mean = Eigen::Vector3d::Zero();
+  int ground = 0, on_wall = 0;
+  for (const auto& p : scan.points) {
+    const Eigen::Vector3d q = T * Eigen::Vector3d(p.x, p.y, p.z);
+    const bool is_ground = std::abs(q.z()) < 0.01, is_wall = std::abs(q.x() - 30.0) < 0.01;
+    EXPECT_TRUE(is_ground || is_wall) << q.transpose();
+    if (is_ground) {
+      ++ground;
+      const Eigen::Vector3d v(p.x, p.y, p.z);
+      ground_mean += v;
+      ground_cov += v * v.transpose();
+    }
+    on_wall += is_wall && !is_ground;
+  }
+  ASSERT_GT(ground, 10000);
+  EXPECT_GT(on_wall, 1000);
+  ground_mean /= ground;
+  ground_cov = ground_cov / ground - ground_mean * ground_mean.transpose();
+  const Eigen::Vector3d normal = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(ground_cov).eigenvectors().col(0);
+  const double tilt_deg = std::acos(std::abs(normal.z())) * 180 / M_PI;
+  const double expected = std::acos(std::cos(12 * M_PI / 180) * std::cos(5 * M_PI / 180)) * 180 / M_PI;
+  EXPECT_NEAR(tilt_deg, expected, 0.05);
+  // Ahead and down: a positive pitch points the sensor's x axis below the horizon.
+  EXPECT_LT(T.linear().col(0).z(), -0.15);
+
+  const PoseList level = relative_lidar_poses(sc);
+  const PoseList tilted = relative_lidar_poses(sc, wall.sensor);
+  const Eigen::Matrix3d M = wall.sensor.mount_rotation();
+  ASSERT_EQ(level.size(), tilted.size());
+  for (std::size_t k = 0; k < level.size(); ++k) {
+    EXPECT_LT((tilted[k].linear() - M.transpose() * level[k].linear() * M).norm(), 1e-12) << k;
+    EXPECT_LT((tilted[k].translation() - M.transpose() * level[k].translation()).norm(), 1e-12) << k;
+  }
+  SimConfig bad;
+  bad.mount_pitch_deg = 95;
+  EXPECT_THROW(sensor_for(bad), Error);
+}
+
 }  // namespace
 }  // namespace scfloam::sim

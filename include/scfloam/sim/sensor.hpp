@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Geometry>
+
 namespace scfloam::sim {
 
 struct SensorModel {
@@ -17,6 +19,12 @@ struct SensorModel {
   double max_range_m = 120.0;    // no return beyond this (and none from the sky)
   double min_range_m = 2.5;      // returns from the ego car / closer than this are dropped
   double mount_height_m = 1.73;  // sensor origin above the road
+  // The sensor's tilt on the vehicle (degrees; roll about the forward x, then pitch about the
+  // left y, positive pitch = nose down): many robots and hand-held rigs tilt their LiDAR to see
+  // the ground near by. The sensor frame is the vehicle frame rotated by Ry(pitch) * Rx(roll)
+  // at the mount point; scans and poses.txt are in the tilted sensor frame.
+  double mount_roll_deg = 0;
+  double mount_pitch_deg = 0;
   double range_noise_m = 0.02;   // gaussian, per return
   double dropout_prob = 0.02;    // random missing returns (plus more at grazing incidence)
   // Residual calibration errors drawn once per sequence (1 sigma): real sensors are
@@ -28,6 +36,9 @@ struct SensorModel {
   // whose points are commonly corrected by raising them ~0.2 deg (IMLS-SLAM, CT-ICP): the
   // ground becomes a shallow cone, heights err by range x bias.
   double elevation_bias_deg = 0;
+
+  // Rotation from the sensor frame to the vehicle frame: Ry(pitch) * Rx(roll).
+  Eigen::Matrix3d mount_rotation() const;
 
   double azimuth_step_deg() const { return 360.0 / columns; }
   int beams() const { return static_cast<int>(elevations_deg.size()); }

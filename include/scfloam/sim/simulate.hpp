@@ -44,6 +44,9 @@ struct SimConfig {
   double beam_elevation_error_deg = -1;
   double beam_azimuth_error_deg = -1;
   double beam_range_bias_m = -1;
+  // The sensor's tilt on the vehicle (SensorModel::mount_roll_deg / mount_pitch_deg).
+  double mount_roll_deg = 0;
+  double mount_pitch_deg = 0;
   TrafficConfig traffic;  // moving cars and pedestrians (on by default)
   bool facade_detail = true;  // recessed windows, ledges, glass on building walls
 };
@@ -67,7 +70,10 @@ Scan render_frame(const Scenario& sc, const SensorModel& sensor, const BeamCalib
 // is created if needed. Same config -> same bytes.
 void simulate_sequence(const SimConfig& config, const std::filesystem::path& out_dir, bool progress);
 
-// Ground-truth lidar poses relative to the first frame (what poses.txt encodes).
-PoseList relative_lidar_poses(const Scenario& scenario);
+// The sensor's pose at time t: the vehicle's (the scenario's trajectory) turned by the mount.
+Pose sensor_pose_at(const Scenario& scenario, const SensorModel& sensor, double t);
+
+// Ground-truth sensor poses relative to the first frame (what poses.txt encodes).
+PoseList relative_lidar_poses(const Scenario& scenario, const SensorModel& sensor = SensorModel{});
 
 }  // namespace scfloam::sim
