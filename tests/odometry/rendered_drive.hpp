@@ -26,8 +26,10 @@ struct RenderedDrive {
 
 // `firing_order`: points column by column, as a raw driver emits them (the simulator writes
 // them beam by beam). The scans are stamped at the middle of their sweeps (cfg.sweep_stamp is
-// not used: stamped_at below gives the same sweeps stamped otherwise).
-inline RenderedDrive render_drive(sim::SimConfig cfg, bool firing_order = false) {
+// not used: stamped_at below gives the same sweeps stamped otherwise). `first_frames` > 0
+// renders only the first frames of the cfg.frames-long scenario (its route depends on its
+// length).
+inline RenderedDrive render_drive(sim::SimConfig cfg, bool firing_order = false, std::size_t first_frames = 0) {
   cfg.sweep_stamp = "middle";
   const sim::SensorModel sensor = sim::sensor_for(cfg);
   const sim::Scenario sc = sim::build_scenario(cfg);
@@ -40,7 +42,8 @@ inline RenderedDrive render_drive(sim::SimConfig cfg, bool firing_order = false)
   const Eigen::Isometry3d T0_end_inv = sc.trajectory.at(sc.frame_time(0) + 0.5 * sensor.sweep_period_s).inverse();
   drive.first_middle_from_start = T0_start_inv * sc.frame_pose(0);
   drive.world_up = T0_inv.linear() * Eigen::Vector3d::UnitZ();
-  for (std::size_t k = 0; k < sc.frames; ++k) {
+  const std::size_t frames = first_frames > 0 ? std::min(first_frames, sc.frames) : sc.frames;
+  for (std::size_t k = 0; k < frames; ++k) {
     const double t = sc.frame_time(k);
     Scan scan = sim::render_frame(sc, sensor, calib, cfg, k);
     if (firing_order) {
