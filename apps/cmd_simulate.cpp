@@ -96,7 +96,7 @@ scfloam::cli::RegisterCommand reg("simulate", [](CLI::App& app) {
                   "The sensor's pitch on the vehicle in degrees, positive = tilted down ahead (default 0)")
       ->check(CLI::Range(-90.0, 90.0));
   sub->add_option("--mount-roll", args->config.mount_roll_deg,
-                  "The sensor's roll on the vehicle in degrees, about the forward axis (default 0)")
+                  "The sensor's roll on the vehicle in degrees, about the forward axis, positive = left side up (default 0)")
       ->check(CLI::Range(-90.0, 90.0));
   sub->add_flag("--no-traffic", args->no_traffic, "A static world: no moving cars or pedestrians");
   sub->add_option("--oncoming-per-min", args->config.traffic.oncoming_per_minute, "Oncoming cars passing per minute")

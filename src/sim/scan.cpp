@@ -33,6 +33,10 @@ Scan render_scan(const World& world, const SensorModel& sensor, const BeamCalibr
   std::vector<std::uint8_t> valid(slots.size(), 0);
   const std::uint64_t frame_seed = hash_combine(hash_combine(seed, 0x5CA7ULL), frame);
 
+  const bool tilted_mount = sensor.mount_roll_deg != 0 || sensor.mount_pitch_deg != 0;
+  const auto [bottom_it, top_it] = std::minmax_element(sensor.elevations_deg.begin(), sensor.elevations_deg.end());
+  const double top_el = (beams > 0 ? *top_it + 1.0 : 0.0) * M_PI / 180;  // + 1 deg: calibration errors
+  const double bottom_el = (beams > 0 ? *bottom_it - 1.0 : 0.0) * M_PI / 180;
   tbb::parallel_for(tbb::blocked_range<int>(0, columns, 16), [&](const tbb::blocked_range<int>& range) {
     std::vector<Primitive> movers, column_movers;
     for (int c = range.begin(); c != range.end(); ++c) {
@@ -53,11 +57,22 @@ Scan render_scan(const World& world, const SensorModel& sensor, const BeamCalibr
         traffic->primitives_at(scan_time_s + time_s, origin.head<2>(), sensor.max_range_m, &movers);
         const Eigen::Vector3d fwd = T_world_col.linear() * Eigen::Vector3d(cos_az, sin_az, 0);
         const double col_bearing = std::atan2(fwd.y(), fwd.x());
+        // A sensor tilted on its mount turns its column's rays out of one vertical plane: their
+        // bearings spread up to the top and bottom beams'. (Level: one plane, no spread, and
+        // the same culling as before the mount existed.)
+        double spread = 0;
+        if (tilted_mount) {
+          for (const double el : {top_el, bottom_el}) {
+            const Eigen::Vector3d ray =
+                T_world_col.linear() * Eigen::Vector3d(std::cos(el) * cos_az, std::cos(el) * sin_az, std::sin(el));
+            spread = std::max(spread, std::abs(std::remainder(std::atan2(ray.y(), ray.x()) - col_bearing, 2 * M_PI)));
+          }
+        }
         for (const Primitive& p : movers) {
           const double dx = p.cx - origin.x(), dy = p.cy - origin.y();
           const double dist = std::hypot(dx, dy), radius = std::hypot(p.hx, p.hy);
           const double diff = std::abs(std::remainder(std::atan2(dy, dx) - col_bearing, 2 * M_PI));
-          if (dist <= radius + 0.5 || diff < std::asin(radius / dist) + 0.03) column_movers.push_back(p);
+          if (dist <= radius + 0.5 || diff < std::asin(radius / dist) + 0.03 + spread) column_movers.push_back(p);
         }
       }
       for (int b = 0; b < beams; ++b) {

@@ -36,11 +36,13 @@ inline RenderedDrive render_drive(sim::SimConfig cfg, bool firing_order = false,
   const sim::BeamCalibration calib = sim::draw_beam_calibration(sensor, cfg.seed);
   RenderedDrive drive;
   drive.route = cfg.route;
-  const Eigen::Isometry3d T0_inv = sc.frame_pose(0).inverse();
+  // The sensor's poses (the vehicle's turned by the mount, as render_frame casts them).
+  const auto at = [&](double t) { return sim::sensor_pose_at(sc, sensor, t); };
+  const Eigen::Isometry3d T0_inv = at(sc.frame_time(0)).inverse();
   drive.sweep_period_s = sensor.sweep_period_s;
-  const Eigen::Isometry3d T0_start_inv = sc.trajectory.at(sc.frame_time(0) - 0.5 * sensor.sweep_period_s).inverse();
-  const Eigen::Isometry3d T0_end_inv = sc.trajectory.at(sc.frame_time(0) + 0.5 * sensor.sweep_period_s).inverse();
-  drive.first_middle_from_start = T0_start_inv * sc.frame_pose(0);
+  const Eigen::Isometry3d T0_start_inv = at(sc.frame_time(0) - 0.5 * sensor.sweep_period_s).inverse();
+  const Eigen::Isometry3d T0_end_inv = at(sc.frame_time(0) + 0.5 * sensor.sweep_period_s).inverse();
+  drive.first_middle_from_start = T0_start_inv * at(sc.frame_time(0));
   drive.world_up = T0_inv.linear() * Eigen::Vector3d::UnitZ();
   const std::size_t frames = first_frames > 0 ? std::min(first_frames, sc.frames) : sc.frames;
   for (std::size_t k = 0; k < frames; ++k) {
@@ -53,9 +55,9 @@ inline RenderedDrive render_drive(sim::SimConfig cfg, bool firing_order = false,
       });
     }
     drive.scans.push_back(std::move(scan));
-    drive.gts.push_back(T0_inv * sc.trajectory.at(t));
-    drive.gts_at_sweep_start.push_back(T0_start_inv * sc.trajectory.at(t - 0.5 * sensor.sweep_period_s));
-    drive.gts_at_sweep_end.push_back(T0_end_inv * sc.trajectory.at(t + 0.5 * sensor.sweep_period_s));
+    drive.gts.push_back(T0_inv * at(t));
+    drive.gts_at_sweep_start.push_back(T0_start_inv * at(t - 0.5 * sensor.sweep_period_s));
+    drive.gts_at_sweep_end.push_back(T0_end_inv * at(t + 0.5 * sensor.sweep_period_s));
   }
   return drive;
 }

@@ -188,9 +188,10 @@ TEST(SimOdometry, DeskewCheckTellsDistortedFromCompensatedScans) {
 }
 
 // Compensated scans that straight driving cannot tell from distorted ones: on the HDL-32E world
-// of seed 11 the deskewed solve's residuals were 5-6 % lower than the shadow's over frames
-// 15-30 (median ratio 0.949), the check kept deskew at frame 31, and from the first turn the
-// deskewed compensated sweeps broke the track (0.66 % t_err over 600 frames). Keeping deskew
+// of seed 11 (`scfloam simulate`, .bin, with traffic) the deskewed solve's residuals were 5-6 %
+// lower than the shadow's over frames 15-30 (median ratio 0.949), the check kept deskew at frame
+// 31, and from the first turn the deskewed compensated sweeps broke the track (0.66 % t_err over
+// 600 frames). The drive rendered here (no traffic, the simulator's point times) does the same. Keeping deskew
 // now needs a 10 % margin; the turn at frame ~57 then shows the scans compensated (docs/odometry.md,
 // "Session 39"). Measured over these 90 frames: "compensated" at frame 59, median ratio 1.051,
 // worst frame 0.008 m, end point 0.09 m; with the old 5 % margin "distorted" at frame 29 (0.941),
@@ -478,8 +479,9 @@ TEST(SimOdometry, Vlp16PresetHoldsTheAttitudeThroughTurns) {
 // A VLP-16 starting at a wide crossing (the 1200-frame loops world of seed 5): the buildings
 // stand 25-50 m back, trees between. Beyond ~29 m its rings lie more than 1 m apart, so with a
 // 1.0 m neighbour radius the far walls matched nothing; the lateral hold came from a few near
-// planes, and the odometry slid sideways from frame 3 (46 % t_err over the whole drive). The
-// preset's 1.25 m radius reaches across two rings there (docs/odometry.md, "Session 39").
+// planes, and the odometry slid sideways from frame 3 (the whole drive through `scfloam run`:
+// 46 % t_err distorted, 0.26 % compensated). The preset's 1.25 m radius reaches across two rings
+// there (docs/odometry.md, "Session 39").
 // Measured over these 40 frames (end-point error, worst frame): 0.19 m, 0.011 m; with 1.0 m
 // 9.1 m, 0.46 m (1.5 m: 0.20, 0.012; 2.0 m: 0.14, 0.008).
 TEST(SimOdometry, Vlp16PresetHoldsItsLineWhereTheWallsStandFarBack) {
@@ -550,11 +552,11 @@ ElevationRun run_unknown_offset(const OdometryConfig& online, std::size_t frames
     out.estimate_deg = r.elevation_correction_deg;
     // The attitude is compared after the estimate's convergence, from frame `from` on.
     if (k == from) {
-      gt0 = sc.frame_pose(k);
+      gt0 = sim::sensor_pose_at(sc, sensor, sc.frame_time(k));
       est0_fixed = est_fixed;
       est0_online = r.T_world_lidar;
     } else if (k > from) {
-      const Eigen::Isometry3d gt = gt0.inverse() * sc.frame_pose(k);
+      const Eigen::Isometry3d gt = gt0.inverse() * sim::sensor_pose_at(sc, sensor, sc.frame_time(k));
       out.tilt_fixed_deg = std::max(out.tilt_fixed_deg, tilt_deg(gt, est0_fixed.inverse() * est_fixed));
       out.tilt_online_deg = std::max(out.tilt_online_deg, tilt_deg(gt, est0_online.inverse() * r.T_world_lidar));
     }

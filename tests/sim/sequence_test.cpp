@@ -67,7 +67,7 @@ TEST_F(SimulatedSequence, KittiConventionRoundTrip) {
   ASSERT_TRUE(seq.ground_truth_camera().has_value());
   EXPECT_TRUE(seq.ground_truth_camera()->front().matrix().isApprox(Eigen::Matrix4d::Identity(), 1e-9));
   const PoseList read = seq.ground_truth_lidar();
-  const PoseList driven = relative_lidar_poses(*scenario_);
+  const PoseList driven = relative_lidar_poses(*scenario_, sensor_for(*config_));
   ASSERT_EQ(read.size(), driven.size());
   for (std::size_t k = 0; k < read.size(); ++k) {
     EXPECT_LT((read[k].translation() - driven[k].translation()).norm(), 1e-6) << k;
@@ -359,23 +359,60 @@ TEST(SimulateMount, ATiltedSensorSeesTheWorldFromItsTiltedFrame) {
   ground_mean /= ground;
   ground_cov = ground_cov / ground - ground_mean * ground_mean.transpose();
   const Eigen::Vector3d normal = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(ground_cov).eigenvectors().col(0);
-  const double tilt_deg = std::acos(std::abs(normal.z())) * 180 / M_PI;
-  const double expected = std::acos(std::cos(12 * M_PI / 180) * std::cos(5 * M_PI / 180)) * 180 / M_PI;
-  EXPECT_NEAR(tilt_deg, expected, 0.05);
+  // The vehicle only turns about the world's up, so "up" in the sensor frame is the mount's
+  // M^T z: pitched 12 deg down ahead, the sensor sees up tilted back (towards -x); rolled -5 deg
+  // (left side down), tilted towards its right (-y).
+  const Eigen::Matrix3d M = wall.sensor.mount_rotation();
+  const Eigen::Vector3d up = M.transpose() * Eigen::Vector3d::UnitZ();
+  EXPECT_LT(up.x(), -0.2);
+  EXPECT_LT(up.y(), -0.08);
+  EXPECT_LT(std::acos(std::min(1.0, std::abs(normal.dot(up)))) * 180 / M_PI, 0.05);
   // Ahead and down: a positive pitch points the sensor's x axis below the horizon.
   EXPECT_LT(T.linear().col(0).z(), -0.15);
 
-  const PoseList level = relative_lidar_poses(sc);
+  const PoseList level = relative_lidar_poses(sc, test::wall_ahead(3).sensor);
   const PoseList tilted = relative_lidar_poses(sc, wall.sensor);
-  const Eigen::Matrix3d M = wall.sensor.mount_rotation();
   ASSERT_EQ(level.size(), tilted.size());
   for (std::size_t k = 0; k < level.size(); ++k) {
     EXPECT_LT((tilted[k].linear() - M.transpose() * level[k].linear() * M).norm(), 1e-12) << k;
     EXPECT_LT((tilted[k].translation() - M.transpose() * level[k].translation()).norm(), 1e-12) << k;
   }
-  SimConfig bad;
-  bad.mount_pitch_deg = 95;
-  EXPECT_THROW(sensor_for(bad), Error);
+  for (const auto& [roll, pitch] : {std::pair<double, double>{0, 95}, {-91, 0}, {0, std::nan("")}}) {
+    SimConfig bad;
+    bad.mount_roll_deg = roll;
+    bad.mount_pitch_deg = pitch;
+    EXPECT_THROW(sensor_for(bad), Error) << roll << " " << pitch;
+  }
+}
+
+// The whole sequence with a tilted mount: poses.txt is the tilted sensor's motion and sim.yaml
+// records the mount.
+TEST(SimulateMount, TheSequenceRecordsTheTiltedSensorsPoses) {
+  SimConfig cfg;
+  cfg.route = "straight";
+  cfg.frames = 3;
+  cfg.sensor = "vlp16";
+  cfg.traffic.enabled = false;
+  cfg.mount_pitch_deg = 10;
+  cfg.mount_roll_deg = 5;
+  const fs::path dir = test::scratch_dir("sim_mount-" + std::to_string(::getpid()));
+  simulate_sequence(cfg, dir, false);
+  const PoseList read = KittiSequence::open(dir).ground_truth_lidar();
+  const PoseList tilted = relative_lidar_poses(build_scenario(cfg), sensor_for(cfg));
+  SimConfig level_cfg = cfg;
+  level_cfg.mount_pitch_deg = level_cfg.mount_roll_deg = 0;
+  const PoseList level = relative_lidar_poses(build_scenario(level_cfg), sensor_for(level_cfg));
+  ASSERT_EQ(read.size(), 3u);
+  ASSERT_EQ(tilted.size(), 3u);
+  for (std::size_t k = 0; k < read.size(); ++k) {
+    EXPECT_LT((read[k].matrix() - tilted[k].matrix()).norm(), 1e-6) << k;
+  }
+  // Driving straight ahead is, for a sensor pitched down, moving up and forward in its frame.
+  EXPECT_GT((read[2].translation() - level[2].translation()).norm(), 0.1);
+  const YAML::Node yaml = YAML::LoadFile((dir / "sim.yaml").string());
+  EXPECT_EQ(yaml["mount_pitch_deg"].as<double>(), 10.0);
+  EXPECT_EQ(yaml["mount_roll_deg"].as<double>(), 5.0);
+  fs::remove_all(dir);
 }
 
 }  // namespace

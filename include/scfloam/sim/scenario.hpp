@@ -21,7 +21,9 @@ struct BeamLoss {
 
 struct Scenario {
   World world;
-  SampledTrajectory trajectory;  // T_world_lidar; frame k is at t = frame_time(k)
+  // The vehicle's pose at the sensor's mount point (the sensor's, for a level mount;
+  // sim::sensor_pose_at turns it by a tilted one); frame k is at t = frame_time(k).
+  SampledTrajectory trajectory;
   std::size_t frames = 0;
   double frame_period_s = 0.1;
   double route_length_m = 0;

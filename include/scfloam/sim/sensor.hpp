@@ -19,10 +19,11 @@ struct SensorModel {
   double max_range_m = 120.0;    // no return beyond this (and none from the sky)
   double min_range_m = 2.5;      // returns from the ego car / closer than this are dropped
   double mount_height_m = 1.73;  // sensor origin above the road
-  // The sensor's tilt on the vehicle (degrees; roll about the forward x, then pitch about the
-  // left y, positive pitch = nose down): many robots and hand-held rigs tilt their LiDAR to see
-  // the ground near by. The sensor frame is the vehicle frame rotated by Ry(pitch) * Rx(roll)
-  // at the mount point; scans and poses.txt are in the tilted sensor frame.
+  // The sensor's tilt on the vehicle (degrees): many robots and hand-held rigs tilt their LiDAR
+  // to see the ground near by. The sensor frame is the vehicle frame rotated by
+  // Ry(pitch) * Rx(roll) at the mount point (roll about the vehicle's forward x, then pitch
+  // about its fixed left y): positive pitch looks down ahead, positive roll lifts the sensor's
+  // left side. Scans and poses.txt are in the tilted sensor frame.
   double mount_roll_deg = 0;
   double mount_pitch_deg = 0;
   double range_noise_m = 0.02;   // gaussian, per return

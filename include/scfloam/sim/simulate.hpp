@@ -74,6 +74,6 @@ void simulate_sequence(const SimConfig& config, const std::filesystem::path& out
 Pose sensor_pose_at(const Scenario& scenario, const SensorModel& sensor, double t);
 
 // Ground-truth sensor poses relative to the first frame (what poses.txt encodes).
-PoseList relative_lidar_poses(const Scenario& scenario, const SensorModel& sensor = SensorModel{});
+PoseList relative_lidar_poses(const Scenario& scenario, const SensorModel& sensor);
 
 }  // namespace scfloam::sim
