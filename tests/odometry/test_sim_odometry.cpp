@@ -191,9 +191,9 @@ TEST(SimOdometry, DeskewCheckTellsDistortedFromCompensatedScans) {
 // of seed 11 (`scfloam simulate`, .bin, with traffic) the deskewed solve's residuals were 5-6 %
 // lower than the shadow's over frames 15-30 (median ratio 0.949), the check kept deskew at frame
 // 31, and from the first turn the deskewed compensated sweeps broke the track (0.66 % t_err over
-// 600 frames). The drive rendered here (no traffic, the simulator's point times) does the same. Keeping deskew
-// now needs a 10 % margin; the turn at frame ~57 then shows the scans compensated (docs/odometry.md,
-// "Session 39"). Measured over these 90 frames: "compensated" at frame 59, median ratio 1.051,
+// 600 frames). The drive rendered here (no traffic, the simulator's point times) does the same.
+// Keeping deskew now needs a 10 % margin; the turn at frame ~57 then shows the scans compensated
+// (docs/odometry.md, "Session 39"). Measured over these 90 frames: "compensated" at frame 59, median ratio 1.051,
 // worst frame 0.008 m, end point 0.09 m; with the old 5 % margin "distorted" at frame 29 (0.941),
 // worst frame 0.043 m, end point 0.36 m.
 TEST(SimOdometry, DeskewCheckWaitsForClearEvidenceBeforeKeepingDeskew) {

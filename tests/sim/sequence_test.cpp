@@ -370,7 +370,9 @@ TEST(SimulateMount, ATiltedSensorSeesTheWorldFromItsTiltedFrame) {
   // Ahead and down: a positive pitch points the sensor's x axis below the horizon.
   EXPECT_LT(T.linear().col(0).z(), -0.15);
 
-  const PoseList level = relative_lidar_poses(sc, test::wall_ahead(3).sensor);
+  SensorModel level_sensor = wall.sensor;
+  level_sensor.mount_pitch_deg = level_sensor.mount_roll_deg = 0;
+  const PoseList level = relative_lidar_poses(sc, level_sensor);
   const PoseList tilted = relative_lidar_poses(sc, wall.sensor);
   ASSERT_EQ(level.size(), tilted.size());
   for (std::size_t k = 0; k < level.size(); ++k) {
