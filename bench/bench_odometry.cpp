@@ -75,7 +75,8 @@ void BM_Features(benchmark::State& state, const char* seq) {
 // whole run's first frames do until the check decides (frame 19 on the KITTI-05-like replay,
 // 196 on the KITTI-00-like one). Without it the step is the steady state, one odometry: the
 // issue's per-frame target. (From session 32, when the check came, to session 40 the plain
-// variant measured the trial: the table's 2x jump of 2026-12-07.)
+// variant measured the trial: median frame 15.9 ms on kitti05 against 8.0 ms steady,
+// docs/benchmarks.md "session 40".)
 void BM_ProcessStep(benchmark::State& state, const char* seq, bool trial = false) {
   const auto& all = scans(seq);
   OdometryConfig config;
