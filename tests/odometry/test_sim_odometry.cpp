@@ -502,9 +502,9 @@ TEST(SimOdometry, Vlp16PresetHoldsItsLineWhereTheWallsStandFarBack) {
 // a 4 % short step, the map's cross walls smeared and stopped matching, the deskew check then
 // found the raw scans fitting better ("compensated" at frame 58 / 82) and the drive ended at
 // 0.71 / 0.92 % t_err (`scfloam run`, 600 frames, as `.bin` / PCD with times; docs/odometry.md,
-// "Session 40"). Measured over these 100
-// frames: weight 10 "distorted" at frame 27 (median ratio 0.885), end point 0.16 m over 60.6 m
-// (5 and 30: the same within 6 mm); weight 3 "compensated" at frame 74 (1.43), 0.34 m.
+// "Session 40"). Measured over these 100 frames: weight 10 "distorted" at frame 27 (median
+// ratio 0.885), end point 0.16 m over 60.6 m (5 and 30: the same within 6 mm); weight 3
+// "compensated" at frame 74 (1.43), 0.34 m.
 TEST(SimOdometry, Vlp16DeskewedStartOnAnOpenSquareKeepsItsSpeed) {
   sim::SimConfig cfg = loops_drive("vlp16", 600, 11);
   cfg.motion_distortion = true;
