@@ -22,9 +22,10 @@ struct PreprocessConfig {
   // assumed: some drivers and datasets compensate the motion but keep the time field, and
   // deskewing such scans again drifts 10-15x (docs/odometry.md, "Session 31"). The odometry
   // also runs without deskew alongside, each in its own map, until the frames in motion
-  // (sweep x speed >= 0.2 m) say which of the two fits its map better (13 of the last 15
-  // agree, their median ratio of mean residuals 5 % off 1), and keeps that one; undecided
-  // after 100 such frames (or 300 frames in all), it keeps deskew.
+  // (the sweep moves its points >= 0.2 m: sweep x (speed + turn rate x the points' mean
+  // range)) say which of the two fits its map better (13 of the last 15 agree, their median
+  // ratio of mean residuals 5 % off 1), and keeps that one; undecided after 100 such frames
+  // (or 300 frames in all), it keeps deskew.
   bool deskew_check = true;
   // Scans without per-point times (KITTI-style .bin, older Velodyne drivers, exported PCD
   // folders) get them from the azimuth when deskew is on: the point order gives the sweep's

@@ -330,13 +330,24 @@ void Odometry::compare_with_shadow(const Scan& scan, OdometryResult& own, const 
   Impl& s = *impl_;
   const bool deskew = s.trial == Impl::Trial::kDeskew;
   SettingCheck& check = deskew ? s.deskew_check : s.elevation_check;
-  // Only frames in motion tell the two apart. Deskew: at 2 m/s a 0.1 s sweep moves 0.2 m.
-  // Elevation: a wrong offset lifts a point by its range times the error, so it shows where a
-  // surface is seen from two places at different ranges: 0.2 m between frames.
+  // Only frames in motion tell the two apart. Deskew: how far the sweep's points move while it
+  // lasts, 0.2 m at 2 m/s; a turn moves them too, by their range times its angle (a hand-held
+  // walk, 1.4 m/s, sways 0.03-0.08 rad per sweep: until session 41 it was never "in motion",
+  // and its check ran 300 frames of a second odometry, undecided). Elevation: a wrong offset
+  // lifts a point by its range times the error, so it shows where a surface is seen from two
+  // places at different ranges: 0.2 m between frames, turns do not count.
   double moved_m = s.T_delta.translation().norm();
   if (deskew) {
     float t_min = 0, t_max = 0;
-    for (const LidarPoint& pt : scan.points) t_min = std::min(t_min, pt.time_s), t_max = std::max(t_max, pt.time_s);
+    double range_sum = 0;
+    std::size_t ranged = 0;
+    for (const LidarPoint& pt : scan.points) {
+      t_min = std::min(t_min, pt.time_s), t_max = std::max(t_max, pt.time_s);
+      const double r = std::sqrt(double(pt.x) * pt.x + double(pt.y) * pt.y + double(pt.z) * pt.z);
+      if (std::isfinite(r)) range_sum += r, ++ranged;
+    }
+    const double mean_range_m = ranged > 0 ? range_sum / static_cast<double>(ranged) : 0.0;
+    moved_m += so3_log(s.T_delta.linear()).norm() * mean_range_m;
     moved_m = s.delta_dt_s > 0 ? moved_m / s.delta_dt_s * (t_max - t_min) : 0.0;
   }
   const bool solved = !own.degenerate && !other.degenerate && own.mean_residual_m > 0 && other.mean_residual_m > 0;
