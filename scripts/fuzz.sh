@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Fuzzes every reader: builds build-fuzz (clang, libFuzzer + ASan + UBSan; SCFLOAM_FUZZ_BUILD
 # names another tree) and runs each fuzz/<name>_fuzz target for SECONDS_PER_TARGET seconds
-# (default 10).
+# (default 10), one target per core at a time.
 # Usage: scripts/fuzz.sh [SECONDS_PER_TARGET] [TARGET...]
 #
 # Two uses:
@@ -91,11 +91,15 @@ seed_from_shared() {
 }
 
 summary="$build/fuzz-summary.txt"
-printf "%-14s %8s %10s %10s %7s %7s %8s %11s  %s\n" target seconds execs execs/s cov ft corpus seed result >"$summary"
-failed=0
 limits=(-timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=2048)
-for name in "${targets[@]}"; do
-  fuzzer="$build/bin/${name}_fuzz" crashes="$build/fuzz-crashes/$name" log="$build/fuzz-$name.log"
+# fuzz_one NAME: replays NAME's saved crashes, fuzzes it, and writes its summary line to
+# $build/fuzz-NAME.row; returns non-zero on a finding. One fuzzer per core at a time: each
+# runs on one thread, so the targets share the machine without changing what any one tries.
+fuzz_one() {
+  local name="$1"
+  local fuzzer="$build/bin/${name}_fuzz" crashes="$build/fuzz-crashes/$name" log="$build/fuzz-$name.log"
+  local row="$build/fuzz-$name.row" corpus result max_len execs cov ft used_seed
+  local -a regressions seed_args seeds
   mkdir -p "$crashes"
   # -timeout: an input taking longer than 10 s is a hang; -rss_limit_mb / -malloc_limit_mb: a
   # 4 GB size field that allocates is a finding, not an out-of-memory of the machine.
@@ -103,9 +107,8 @@ for name in "${targets[@]}"; do
   if [ -e "${regressions[0]}" ] &&
      ! "$fuzzer" "${limits[@]}" "${regressions[@]}" >"$build/fuzz-$name-regressions.log" 2>&1; then
     printf "%-14s %8s %10s %10s %7s %7s %8s %11s  %s\n" "$name" 0 "${#regressions[@]}" - - - - - \
-      "REGRESSION (see $build/fuzz-$name-regressions.log)" >>"$summary"
-    failed=1
-    continue
+      "REGRESSION (see $build/fuzz-$name-regressions.log)" >"$row"
+    return 1
   fi
   if [ -n "$seed" ]; then
     corpus="$build/fuzz-corpus-seed/$name"
@@ -127,7 +130,6 @@ for name in "${targets[@]}"; do
       -max_len="$max_len" -print_final_stats=1 -artifact_prefix="$crashes/" \
       "$corpus" "${seeds[@]}" >"$log" 2>&1; then
     result="CRASH (see $log and $crashes/)"
-    failed=1
     grep -E "ERROR|SUMMARY|Test unit written" "$log" | head -n 8 || true
   fi
   execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -n 1)
@@ -136,7 +138,29 @@ for name in "${targets[@]}"; do
   used_seed=$(sed -n 's/^INFO: Seed: *//p' "$log" | head -n 1)
   printf "%-14s %8s %10s %10s %7s %7s %8s %11s  %s\n" "$name" "$seconds" "${execs:-?}" \
     "$(( ${execs:-0} / (seconds > 0 ? seconds : 1) ))" "${cov:-?}" "${ft:-?}" \
-    "$(ls "$corpus" | wc -l)" "${used_seed:-?}" "$result" >>"$summary"
+    "$(ls "$corpus" | wc -l)" "${used_seed:-?}" "$result" >"$row"
+  [ "$result" = ok ]
+}
+
+failed=0
+running=0
+for name in "${targets[@]}"; do
+  rm -f "$build/fuzz-$name.row"
+  if [ "$running" -ge "$(nproc)" ]; then
+    wait -n || failed=1
+    running=$((running - 1))
+  fi
+  fuzz_one "$name" &
+  running=$((running + 1))
+done
+while [ "$running" -gt 0 ]; do
+  wait -n || failed=1
+  running=$((running - 1))
+done
+printf "%-14s %8s %10s %10s %7s %7s %8s %11s  %s\n" target seconds execs execs/s cov ft corpus seed result >"$summary"
+for name in "${targets[@]}"; do
+  if [ -f "$build/fuzz-$name.row" ]; then cat "$build/fuzz-$name.row" >>"$summary"
+  else printf "%-14s %s\n" "$name" "NO RESULT (the harness itself failed)" >>"$summary"; failed=1; fi
 done
 cat "$summary"
 if [ "$failed" = 1 ] && [ -n "$seed" ]; then
