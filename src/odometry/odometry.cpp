@@ -200,7 +200,14 @@ Eigen::Isometry3d coarse_alignment(const OdometryConfig& c, const FeatureCloud& 
     return T_pred;
   RegistrationConfig coarse = c.registration;
   coarse.max_neighbor_dist_m = c.registration.coarse_neighbor_dist_m;
-  coarse.degeneracy_fallback = false;
+  // The guess is poor everywhere, so the matches decide wherever they say anything; where
+  // they say nothing (less than one match's worth of information: a walk starting along a
+  // single wall), the cost is flat and the solve would wander, and the rest of a drive that
+  // stays that way would keep the wandered velocity: the guess is kept there.
+  coarse.degeneracy_fallback = true;
+  coarse.degeneracy_min_eigenvalue = coarse.degeneracy_min_rotation_eigenvalue = 1.0;
+  coarse.degeneracy_min_translation_ratio = coarse.degeneracy_min_rotation_ratio = 0;
+  coarse.degeneracy_prior_translation_weight = coarse.degeneracy_prior_rotation_weight = 0;
   coarse.edge_max_residual_m = 0;  // the start may be a metre off: every line within reach counts
   coarse.edge_view_tolerance_deg = 0;
   LocalMapConfig coarse_map = c.map;
