@@ -20,7 +20,31 @@ Pose SampledTrajectory::at(double t_s) const {
   const double alpha = f - static_cast<double>(i);
   const Pose& a = T_world_lidar[i];
   const Pose& b = T_world_lidar[i + 1];
-  if (alpha >= 0 && alpha <= 1) return interpolate(a, b, alpha);
+  if (alpha >= 0 && alpha <= 1) {
+    if (!smooth) return interpolate(a, b, alpha);
+    // At a sample, the sample itself (frame times reach here as f = k -+ 1e-15).
+    if (alpha < 1e-9) return a;
+    if (alpha > 1 - 1e-9) return b;
+    // The four samples around, as rotation vectors and translations in a's frame (at the
+    // ends the missing neighbour mirrors the other: a constant velocity there).
+    const auto rel = [&](const Pose& T) {
+      const Pose d = a.inverse() * T;
+      Eigen::Matrix<double, 6, 1> xi;
+      xi << so3_log(d.linear()), d.translation();
+      return xi;
+    };
+    const Eigen::Matrix<double, 6, 1> p1 = rel(b);
+    const Eigen::Matrix<double, 6, 1> p_1 = i > 0 ? rel(T_world_lidar[i - 1]) : Eigen::Matrix<double, 6, 1>(-p1);
+    const Eigen::Matrix<double, 6, 1> p2 = i + 2 <= last ? rel(T_world_lidar[i + 2]) : Eigen::Matrix<double, 6, 1>(2 * p1);
+    // Catmull-Rom through p0 = 0 and p1, tangents (p1 - p_1) / 2 and (p2 - 0) / 2.
+    const double a2 = alpha * alpha, a3 = a2 * alpha;
+    const Eigen::Matrix<double, 6, 1> xi =
+        0.5 * ((-a3 + 2 * a2 - alpha) * p_1 + (-3 * a3 + 4 * a2 + alpha) * p1 + (a3 - a2) * p2);
+    Pose step = Pose::Identity();
+    step.linear() = so3_exp(xi.head<3>());
+    step.translation() = xi.tail<3>();
+    return a * step;
+  }
   // Extrapolate: apply the relative motion of the interval |alpha| times (small angles).
   const Pose delta = a.inverse() * b;
   Eigen::Matrix<double, 6, 1> xi;

@@ -12,6 +12,16 @@
 #include "scfloam/sim/rng.hpp"
 
 namespace scfloam::sim {
+namespace {
+
+// The pose at `frac` (0 ... 1) of a sweep sampled evenly at `along` (two or more poses).
+Pose along_sweep(const std::vector<Pose>& along, double frac) {
+  const double f = std::clamp(frac, 0.0, 1.0) * static_cast<double>(along.size() - 1);
+  const std::size_t i = std::min(static_cast<std::size_t>(f), along.size() - 2);
+  return interpolate(along[i], along[i + 1], f - static_cast<double>(i));
+}
+
+}  // namespace
 
 Scan render_scan(const World& world, const SensorModel& sensor, const BeamCalibration& calib,
                  const SweepPoses& poses, std::uint64_t seed, std::uint64_t frame,
@@ -43,9 +53,10 @@ Scan render_scan(const World& world, const SensorModel& sensor, const BeamCalibr
       const double frac = (c + 0.5) / columns;
       // Clockwise from behind the car: azimuth +180 deg -> -180 deg.
       const double az = M_PI - 2 * M_PI * frac;
-      const Pose T_world_col = poses.motion_distortion
-                                   ? interpolate(poses.T_world_lidar_start, poses.T_world_lidar_end, frac)
-                                   : poses.T_world_lidar;
+      const Pose T_world_col = !poses.motion_distortion ? poses.T_world_lidar
+                               : poses.T_world_lidar_along.size() >= 2
+                                   ? along_sweep(poses.T_world_lidar_along, frac)
+                                   : interpolate(poses.T_world_lidar_start, poses.T_world_lidar_end, frac);
       const Eigen::Vector3d origin = T_world_col.translation();
       const double cos_az = std::cos(az), sin_az = std::sin(az);
       const float time_s = static_cast<float>((frac - 0.5) * sensor.sweep_period_s);

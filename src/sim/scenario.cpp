@@ -297,6 +297,7 @@ Scenario make_replay_scenario(const PoseList& T_lidar0_lidar, std::uint64_t seed
   const WorldBounds bounds = bounds_of(streets, 80);
   sc.world = build_city(streets, fit_terrain(bounds, ground), seed, &sc.stats);
   sc.trajectory.dt_s = 0.1;
+  sc.trajectory.smooth = true;  // one pose per frame: a sweep in between moves along a curve
   sc.trajectory.T_world_lidar = T_lidar0_lidar;
   // x, y and the rotation are the file's; the height rides on the (single-valued) terrain,
   // since ground truths drift vertically between passes and the world cannot follow both.

@@ -73,6 +73,13 @@ Scan render_frame(const Scenario& sc, const SensorModel& sensor, const BeamCalib
   poses.motion_distortion = config.motion_distortion;
   poses.T_world_lidar_start = at(middle - 0.5 * sensor.sweep_period_s);
   poses.T_world_lidar_end = at(middle + 0.5 * sensor.sweep_period_s);
+  if (config.motion_distortion) {
+    // The trajectory every hundredth of a second through the sweep (routes are sampled at
+    // 100 Hz; a replay's 10 Hz poses are interpolated between).
+    constexpr int kSteps = 10;
+    for (int i = 0; i <= kSteps; ++i)
+      poses.T_world_lidar_along.push_back(at(middle + (static_cast<double>(i) / kSteps - 0.5) * sensor.sweep_period_s));
+  }
   Scan scan = render_scan(sc.world, sensor, calib, poses, config.seed, k, traffic, middle);
   // render_scan counts point times from the sweep's middle.
   if (middle != stamp) {

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <utility>
 
 #include "scfloam/io/kitti.hpp"
 #include "scfloam/io/trajectory.hpp"
@@ -137,6 +138,41 @@ TEST(ReplayRoute, FollowsKittiPosesWithAClearRoad) {
 
 namespace scfloam::sim {
 namespace {
+
+// A trajectory sampled once per frame (a replay) and joined by a cubic passes through its
+// samples and turns and pitches without a kink at them: a sweep around a sample moves along
+// a curve, as a sensor does, not along two straight pieces.
+TEST(SampledTrajectory, ASmoothReplayPassesThroughItsPosesWithoutKinks) {
+  SampledTrajectory traj;
+  traj.dt_s = 0.1;
+  for (int k = 0; k < 8; ++k) {  // pitching at 1 Hz by 8 deg while walking and turning
+    const double t = 0.1 * k;
+    Pose T = Pose::Identity();
+    T.linear() = (Eigen::AngleAxisd(0.5 * t, Eigen::Vector3d::UnitZ()) *
+                  Eigen::AngleAxisd(0.14 * std::sin(2 * M_PI * t), Eigen::Vector3d::UnitY())).toRotationMatrix();
+    T.translation() = Eigen::Vector3d(1.4 * t, 0.2 * t * t, 0);
+    traj.T_world_lidar.push_back(T);
+  }
+  // The rotation rate (rad/s) just before and just after time t.
+  const auto rates = [&](double t) {
+    const double h = 1e-4;
+    const Eigen::Vector3d before = so3_log(traj.at(t - h).linear().transpose() * traj.at(t).linear()) / h;
+    const Eigen::Vector3d after = so3_log(traj.at(t).linear().transpose() * traj.at(t + h).linear()) / h;
+    return std::pair{before, after};
+  };
+  for (const bool smooth : {false, true}) {
+    traj.smooth = smooth;
+    for (int k = 0; k < 8; ++k) {
+      EXPECT_LT((traj.at(0.1 * k).translation() - traj.T_world_lidar[k].translation()).norm(), 1e-9);
+      EXPECT_LT(so3_log(traj.at(0.1 * k).linear().transpose() * traj.T_world_lidar[k].linear()).norm(), 1e-9);
+    }
+    const auto [before, after] = rates(0.3);
+    // Straight pieces: the pitch rate jumps by ~0.5 rad/s at the sample; the cubic: by the
+    // finite difference's own error.
+    if (smooth) EXPECT_LT((after - before).norm(), 0.01) << "smooth";
+    else EXPECT_GT((after - before).norm(), 0.3) << "straight pieces";
+  }
+}
 
 TEST(LoopsRoute, CarBodyStaysOnTheRoadClearOfObjects) {
   for (std::uint64_t seed : {1, 2, 7}) {

@@ -289,6 +289,32 @@ TEST(SimulateMotionDistortion, ColumnsFollowTheMovingSensor) {
   EXPECT_NEAR(max_t, 0.05, 1e-3);
 }
 
+// Given the trajectory through the sweep, the columns follow it, not the chord from its start
+// to its end: the middle column is seen from the middle pose (here 0.2 m ahead of the chord's
+// middle, as a sensor that slows down within the sweep).
+TEST(SimulateMotionDistortion, ColumnsFollowTheTrajectoryThroughTheSweep) {
+  const test::WallAhead wall = test::wall_ahead(1);
+  SweepPoses poses;
+  poses.T_world_lidar = Pose::Identity();
+  poses.T_world_lidar.translation().z() = 1.73;
+  poses.motion_distortion = true;
+  poses.T_world_lidar_start = poses.T_world_lidar_end = poses.T_world_lidar;
+  poses.T_world_lidar_start.translation().x() = -0.5;
+  poses.T_world_lidar_end.translation().x() = 0.5;
+  poses.T_world_lidar_along = {poses.T_world_lidar_start, poses.T_world_lidar, poses.T_world_lidar_end};
+  poses.T_world_lidar_along[1].translation().x() = 0.2;
+  const Scan scan = render_scan(wall.scenario.world, wall.sensor, wall.calibration, poses, 1, 0);
+  int n = 0;
+  for (const auto& p : scan.points) {
+    if (p.x < 25 || p.z < 0) continue;
+    // x of the sensor: -0.5 -> 0.2 over the first half (14 m/s), 0.2 -> 0.5 over the second (6 m/s).
+    const double sensor_x = p.time_s < 0 ? 0.2 + 14.0 * p.time_s : 0.2 + 6.0 * p.time_s;
+    EXPECT_NEAR(p.x, 30.0 - sensor_x, 0.002);
+    ++n;
+  }
+  EXPECT_GT(n, 1000);
+}
+
 // `--sweep-stamp`: a scan stamped at its sweep's start, middle or end. Wherever the stamp is,
 // a point is the wall seen from the sensor at stamp + time_s, and a compensated scan is seen
 // from the sensor at the stamp (the sensor drives at 10 m/s along x towards a wall at x = 30).

@@ -15,6 +15,11 @@ namespace scfloam::sim {
 struct SampledTrajectory {
   double dt_s = 0.01;
   PoseList T_world_lidar;
+  // Between samples: false, along the straight screw between the two (fine for 100 Hz
+  // routes); true, along a cubic through the neighbouring samples as well (Catmull-Rom in the
+  // earlier sample's tangent space), so that a trajectory sampled at the frame rate (a replay)
+  // changes speed and turn rate smoothly within a sweep instead of at each sample.
+  bool smooth = false;
   Pose at(double t_s) const;
   double duration_s() const { return T_world_lidar.empty() ? 0 : (T_world_lidar.size() - 1) * dt_s; }
 };
