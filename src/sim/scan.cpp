@@ -53,10 +53,9 @@ Scan render_scan(const World& world, const SensorModel& sensor, const BeamCalibr
       const double frac = (c + 0.5) / columns;
       // Clockwise from behind the car: azimuth +180 deg -> -180 deg.
       const double az = M_PI - 2 * M_PI * frac;
-      const Pose T_world_col = !poses.motion_distortion ? poses.T_world_lidar
-                               : poses.T_world_lidar_along.size() >= 2
+      const Pose T_world_col = poses.motion_distortion && poses.T_world_lidar_along.size() >= 2
                                    ? along_sweep(poses.T_world_lidar_along, frac)
-                                   : interpolate(poses.T_world_lidar_start, poses.T_world_lidar_end, frac);
+                                   : poses.T_world_lidar;
       const Eigen::Vector3d origin = T_world_col.translation();
       const double cos_az = std::cos(az), sin_az = std::sin(az);
       const float time_s = static_cast<float>((frac - 0.5) * sensor.sweep_period_s);

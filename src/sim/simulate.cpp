@@ -71,8 +71,6 @@ Scan render_frame(const Scenario& sc, const SensorModel& sensor, const BeamCalib
   SweepPoses poses;
   poses.T_world_lidar = at(config.motion_distortion ? middle : stamp);
   poses.motion_distortion = config.motion_distortion;
-  poses.T_world_lidar_start = at(middle - 0.5 * sensor.sweep_period_s);
-  poses.T_world_lidar_end = at(middle + 0.5 * sensor.sweep_period_s);
   if (config.motion_distortion) {
     // The trajectory every hundredth of a second through the sweep (routes are sampled at
     // 100 Hz; a replay's 10 Hz poses are interpolated between).

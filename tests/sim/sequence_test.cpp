@@ -272,9 +272,9 @@ TEST(SimulateMotionDistortion, ColumnsFollowTheMovingSensor) {
   poses.T_world_lidar = Pose::Identity();
   poses.T_world_lidar.translation().z() = 1.73;
   poses.motion_distortion = true;
-  poses.T_world_lidar_start = poses.T_world_lidar_end = poses.T_world_lidar;
-  poses.T_world_lidar_start.translation().x() = -0.5;  // 10 m/s along +x
-  poses.T_world_lidar_end.translation().x() = 0.5;
+  poses.T_world_lidar_along = {poses.T_world_lidar, poses.T_world_lidar};
+  poses.T_world_lidar_along[0].translation().x() = -0.5;  // 10 m/s along +x
+  poses.T_world_lidar_along[1].translation().x() = 0.5;
   const Scan scan = render_scan(w, s, calib, poses, 1, 0);
   int n = 0;
   for (const auto& p : scan.points) {
@@ -298,11 +298,10 @@ TEST(SimulateMotionDistortion, ColumnsFollowTheTrajectoryThroughTheSweep) {
   poses.T_world_lidar = Pose::Identity();
   poses.T_world_lidar.translation().z() = 1.73;
   poses.motion_distortion = true;
-  poses.T_world_lidar_start = poses.T_world_lidar_end = poses.T_world_lidar;
-  poses.T_world_lidar_start.translation().x() = -0.5;
-  poses.T_world_lidar_end.translation().x() = 0.5;
-  poses.T_world_lidar_along = {poses.T_world_lidar_start, poses.T_world_lidar, poses.T_world_lidar_end};
+  poses.T_world_lidar_along = {poses.T_world_lidar, poses.T_world_lidar, poses.T_world_lidar};
+  poses.T_world_lidar_along[0].translation().x() = -0.5;
   poses.T_world_lidar_along[1].translation().x() = 0.2;
+  poses.T_world_lidar_along[2].translation().x() = 0.5;
   const Scan scan = render_scan(wall.scenario.world, wall.sensor, wall.calibration, poses, 1, 0);
   int n = 0;
   for (const auto& p : scan.points) {

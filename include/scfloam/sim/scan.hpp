@@ -15,14 +15,13 @@ namespace scfloam::sim {
 struct SweepPoses {
   Pose T_world_lidar;  // at the scan timestamp (mid-sweep, lidar facing forward)
   // Off: every column is cast from T_world_lidar (a motion-compensated scan, as KITTI's).
-  // On: column c is cast from interpolate(start, end, (c + 0.5) / columns) and its points are
-  // reported in that moving frame, uncompensated, as a raw sensor does.
+  // On: column c is cast from T_world_lidar_along (two or more poses, evenly spaced from the
+  // sweep's start to its end) interpolated piecewise at (c + 0.5) / columns, and its points are
+  // reported in that moving frame, uncompensated, as a raw sensor does. render_frame samples
+  // the trajectory every 10 ms: two poses only (a chord from start to end) would miss the
+  // sweep's middle pose by a quarter of the motion's second difference over the sweep (0.6 deg
+  // for a hand-held sensor pitching 8 deg at 0.9 Hz).
   bool motion_distortion = false;
-  Pose T_world_lidar_start, T_world_lidar_end;
-  // When given (at least two, evenly spaced from the sweep's start to its end), column c is cast
-  // from these, interpolated piecewise: the trajectory itself rather than the chord from start
-  // to end, which misses the sweep's middle pose by a quarter of the motion's second difference
-  // over the sweep (0.6 deg for a hand-held sensor pitching 8 deg at 0.9 Hz).
   std::vector<Pose> T_world_lidar_along;
 };
 
